@@ -1,0 +1,219 @@
+//! Point location by a remembering stochastic walk, the conflict region by breadth-first
+//! search, and starring the hole.
+
+use super::{Engine, Inserted};
+use crate::predicates::Sign;
+use crate::space::{Lifted, OrbitSpace};
+use crate::tds::NONE;
+
+impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
+    /// The cell containing the lifted point `q`, and `q`'s offset in that cell's frame.
+    /// Remembering stochastic walk: never step back through the facet just crossed, and try
+    /// the facets in a random rotation.
+    pub fn locate_from(&mut self, q: Lifted<S::Point, S::Offset>, start: u32) -> (u32, S::Offset) {
+        let (p, mut qo) = q;
+        let mut c = start;
+        let mut prev = NONE;
+        'walk: loop {
+            let r = self.rng.below(N);
+            let mut s = self.lifted_cell(c);
+            for k in 0..N {
+                let i = (r + k) % N;
+                let d = self.tds.cells[c as usize].n[i];
+                if d == prev {
+                    continue;
+                }
+                let keep = s[i];
+                s[i] = (p, qo);
+                let o = self.space.orient(&s);
+                s[i] = keep;
+                if o == Sign::Negative {
+                    let t = self.translation(c, i, d);
+                    qo = self.space.difference(qo, t);
+                    prev = c;
+                    c = d;
+                    continue 'walk;
+                }
+            }
+            return (c, qo);
+        }
+    }
+
+    /// The cell containing the point (offset 0), starting from the last insertion.
+    pub fn locate(&mut self, p: S::Point) -> (u32, S::Offset) {
+        let start = self.start_cell();
+        self.locate_from((p, S::Offset::default()), start)
+    }
+
+    /// Collects the cells whose circumsphere contains `q` (starting at `c0`, which contains
+    /// `q`) and the facets bounding them.
+    fn find_conflicts(&mut self, c0: u32, q0: S::Offset, p: S::Point) {
+        let (inside, outside) = self.tds.new_visit();
+        let mut scratch = std::mem::take(&mut self.scratch);
+        scratch.conflict.clear();
+        scratch.boundary.clear();
+        scratch.conflict.push((c0, q0));
+        self.tds.set_stamp(c0, inside);
+        let mut next = 0;
+        while next < scratch.conflict.len() {
+            let (c, qo) = scratch.conflict[next];
+            for i in 0..N {
+                let d = self.tds.cells[c as usize].n[i];
+                let st = self.tds.stamp(d);
+                if st == inside {
+                    continue;
+                }
+                if st != outside {
+                    let qd = self.space.difference(qo, self.translation(c, i, d));
+                    if self.space.in_sphere(&self.lifted_cell(d), (p, qd)) == Sign::Positive {
+                        self.tds.set_stamp(d, inside);
+                        scratch.conflict.push((d, qd));
+                        continue;
+                    }
+                    self.tds.set_stamp(d, outside);
+                }
+                scratch.boundary.push((next as u32, i as u8));
+            }
+            next += 1;
+        }
+        self.scratch = scratch;
+    }
+
+    /// Replaces the conflict region by the cone from the new vertex `x` over its boundary.
+    fn star_hole(&mut self, x: u32) {
+        let mut scratch = std::mem::take(&mut self.scratch);
+        let inside = self.tds.stamp(scratch.conflict[0].0);
+        scratch.created.clear();
+        // 1. one new cell per boundary facet, linked to the outside neighbour; the conflict
+        //    cell's pointer through that facet is redirected to the new cell.
+        for &(ci, i) in &scratch.boundary {
+            let (c, qo) = scratch.conflict[ci as usize];
+            let i = i as usize;
+            let cell = self.tds.cells[c as usize];
+            let mut v = cell.v;
+            let mut off = cell.off;
+            v[i] = x;
+            off[i] = qo;
+            let nc = self.make_cell(v, off);
+            let d = cell.n[i];
+            let j = self.tds.cells[d as usize]
+                .mirror(c)
+                .expect("symmetric neighbours");
+            self.link(nc, i, d, j);
+            self.tds.cells[c as usize].n[i] = nc;
+            scratch.created.push(nc);
+        }
+        // 2. link the new cells around each ridge by rotating through the conflict region.
+        for (k, &(ci, i)) in scratch.boundary.iter().enumerate() {
+            let nc = scratch.created[k];
+            let c0 = scratch.conflict[ci as usize].0;
+            let i = i as usize;
+            for j in 0..N {
+                if j == i || self.tds.cells[nc as usize].n[j] != NONE {
+                    continue;
+                }
+                let c0cell = &self.tds.cells[c0 as usize];
+                let (mut u, mut w) = (c0cell.v[i], c0cell.v[j]);
+                let mut cur = c0;
+                loop {
+                    let cc = &self.tds.cells[cur as usize];
+                    let kw = cc.index_of(w).expect("ridge rotation");
+                    let nb = cc.n[kw];
+                    if self.tds.stamp(nb) != inside {
+                        // (cur, kw) is a boundary facet and nb the new cell built on it
+                        let ku = cc.index_of(u).expect("ridge rotation");
+                        self.link(nc, j, nb, ku);
+                        break;
+                    }
+                    let m = self.tds.cells[nb as usize]
+                        .mirror(cur)
+                        .expect("symmetric neighbours");
+                    let xv = self.tds.cells[nb as usize].v[m];
+                    w = u;
+                    u = xv;
+                    cur = nb;
+                }
+            }
+        }
+        for &(c, _) in &scratch.conflict {
+            self.kill_cell(c);
+        }
+        for &nc in &scratch.created {
+            self.attach(nc);
+        }
+        self.hint = scratch.created[0];
+        self.scratch = scratch;
+    }
+
+    /// Inserts the lifted point `q` of point `point` as vertex `x`, or reports the vertex it
+    /// coincides with (checked only when `check_duplicate`).
+    pub(crate) fn insert_lifted(
+        &mut self,
+        q: Lifted<S::Point, S::Offset>,
+        x: u32,
+        check_duplicate: bool,
+    ) -> Result<(), u32> {
+        let start = self.start_cell();
+        let (c, qo) = self.locate_from(q, start);
+        if check_duplicate {
+            for i in 0..N {
+                if self.space.coincide(self.lifted(c, i), (q.0, qo)) {
+                    self.hint = c;
+                    return Err(self.tds.cells[c as usize].v[i]);
+                }
+            }
+        }
+        self.find_conflicts(c, qo, q.0);
+        self.star_hole(x);
+        Ok(())
+    }
+
+    /// Inserts a point of the domain. In the covering space every copy is inserted, and the
+    /// triangulation switches to the 1-sheeted quotient as soon as the criterion holds.
+    pub fn insert(&mut self, p: S::Point) -> Inserted {
+        if self.points.is_empty() {
+            self.points.push(p);
+            self.bootstrap_covering();
+            return Inserted::New(0);
+        }
+        let pi = self.points.len() as u32;
+        if self.one_sheeted && !self.guaranteed {
+            // A 1-sheeted triangulation kept without the criterion may not stay valid: go
+            // back to the covering first.
+            self.rebuild_in_covering();
+        }
+        if self.one_sheeted {
+            self.points.push(p);
+            self.vpoint.push(pi);
+            self.vcell.push(NONE);
+            match self.insert_lifted((p, S::Offset::default()), pi, true) {
+                Ok(()) => Inserted::New(pi),
+                Err(v) => {
+                    self.points.pop();
+                    self.vpoint.pop();
+                    self.vcell.pop();
+                    Inserted::Duplicate(self.vpoint[v as usize])
+                }
+            }
+        } else {
+            self.points.push(p);
+            let copies = self.space.covering_copies();
+            for (k, o) in copies.into_iter().enumerate() {
+                let x = self.vpoint.len() as u32;
+                self.vpoint.push(pi);
+                self.vcell.push(NONE);
+                if let Err(v) = self.insert_lifted((p, o), x, k == 0) {
+                    self.points.pop();
+                    self.vpoint.pop();
+                    self.vcell.pop();
+                    return Inserted::Duplicate(self.vpoint[v as usize]);
+                }
+            }
+            if self.big_count == 0 {
+                self.convert_to_one_sheet();
+                self.guaranteed = true;
+            }
+            Inserted::New(pi)
+        }
+    }
+}

@@ -1,0 +1,225 @@
+//! The incremental Delaunay engine, written once for every orbit space and dimension
+//! (`N` = vertices per cell). It stores either a triangulation of the initial covering space
+//! (every point present once per sheet) or, as soon as the switch criterion holds, of the
+//! 1-sheeted quotient. Cells store each vertex's offset in units of the original lattice, so
+//! one insertion code path serves both (thesis Algorithm 2.3.1).
+
+mod covering;
+mod insert;
+mod remove;
+mod validate;
+mod wrap;
+
+use crate::predicates::Sign;
+use crate::sort::SplitMix;
+use crate::space::{Lifted, OrbitSpace};
+use crate::tds::{Cell, Tds, NONE};
+
+pub use validate::Invalid;
+
+/// Reusable buffers of one insertion or removal (no allocation per point).
+#[derive(Debug, Default)]
+struct Scratch<O> {
+    /// Conflict cells with the query's offset in each cell's frame.
+    conflict: Vec<(u32, O)>,
+    /// Boundary facets: (index into `conflict`, facet).
+    boundary: Vec<(u32, u8)>,
+    /// New cells, parallel to `boundary`.
+    created: Vec<u32>,
+}
+
+/// The result of inserting one point.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Inserted {
+    /// A new vertex for the point with this index.
+    New(u32),
+    /// The point coincides with the existing point of this index.
+    Duplicate(u32),
+}
+
+/// A Delaunay triangulation of an orbit space.
+#[derive(Debug)]
+pub struct Engine<S: OrbitSpace<N>, const N: usize> {
+    pub(crate) space: S,
+    /// The distinct points (dummy points, while present, at the end).
+    pub(crate) points: Vec<S::Point>,
+    /// Vertex → its point (1-sheeted: the identity; covering: one vertex per copy).
+    pub(crate) vpoint: Vec<u32>,
+    /// Vertex → one incident cell.
+    pub(crate) vcell: Vec<u32>,
+    pub(crate) tds: Tds<S::Offset, N>,
+    pub(crate) one_sheeted: bool,
+    /// True while the switch criterion is known to hold, so that further insertions keep a
+    /// valid 1-sheeted triangulation.
+    pub(crate) guaranteed: bool,
+    /// Covering only: cells whose circumradius is too large for the switch criterion.
+    big: Vec<bool>,
+    big_count: usize,
+    hint: u32,
+    rng: SplitMix,
+    scratch: Scratch<S::Offset>,
+}
+
+impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
+    /// An empty triangulation of the space.
+    pub fn new(space: S) -> Self {
+        Engine {
+            space,
+            points: Vec::new(),
+            vpoint: Vec::new(),
+            vcell: Vec::new(),
+            tds: Tds::new(),
+            one_sheeted: false,
+            guaranteed: false,
+            big: Vec::new(),
+            big_count: 0,
+            hint: 0,
+            rng: SplitMix::new(0x5eed),
+            scratch: Scratch::default(),
+        }
+    }
+
+    /// The orbit space.
+    pub fn space(&self) -> &S {
+        &self.space
+    }
+
+    /// The distinct points, in insertion order of their first occurrence.
+    pub fn points(&self) -> &[S::Point] {
+        &self.points
+    }
+
+    /// Number of sheets of the stored triangulation (1 once it lives in the quotient).
+    pub fn sheets(&self) -> usize {
+        if self.one_sheeted || self.points.is_empty() {
+            1
+        } else {
+            self.space.sheets()
+        }
+    }
+
+    /// True when the stored triangulation is the 1-sheeted quotient.
+    pub fn is_one_sheeted(&self) -> bool {
+        self.one_sheeted
+    }
+
+    /// True when the switch criterion (`Δ < δ/2`) is known to hold.
+    pub fn criterion_holds(&self) -> bool {
+        self.guaranteed
+    }
+
+    /// Number of stored vertices (`sheets × points`).
+    pub fn number_of_vertices(&self) -> usize {
+        self.vpoint.len()
+    }
+
+    /// Number of stored cells.
+    pub fn number_of_cells(&self) -> usize {
+        self.tds.len()
+    }
+
+    /// Ids of the stored cells.
+    pub fn cell_ids(&self) -> impl Iterator<Item = u32> + '_ {
+        self.tds.ids()
+    }
+
+    /// A stored cell.
+    pub fn cell(&self, c: u32) -> &Cell<S::Offset, N> {
+        &self.tds.cells[c as usize]
+    }
+
+    /// The point index of a vertex.
+    pub fn point_of(&self, v: u32) -> u32 {
+        self.vpoint[v as usize]
+    }
+
+    /// One cell incident to vertex `v`.
+    pub fn incident_cell(&self, v: u32) -> u32 {
+        self.vcell[v as usize]
+    }
+
+    /// The lifted vertex `i` of cell `c`.
+    #[inline]
+    pub fn lifted(&self, c: u32, i: usize) -> Lifted<S::Point, S::Offset> {
+        let cell = &self.tds.cells[c as usize];
+        (
+            self.points[self.vpoint[cell.v[i] as usize] as usize],
+            cell.off[i],
+        )
+    }
+
+    /// All lifted vertices of cell `c`.
+    #[inline]
+    pub fn lifted_cell(&self, c: u32) -> [Lifted<S::Point, S::Offset>; N] {
+        std::array::from_fn(|i| self.lifted(c, i))
+    }
+
+    /// The offset that maps the frame of `d = neighbour(c, i)` onto the frame of `c`.
+    #[inline]
+    pub fn translation(&self, c: u32, i: usize, d: u32) -> S::Offset {
+        let cc = &self.tds.cells[c as usize];
+        let dc = &self.tds.cells[d as usize];
+        let k = (i + 1) % N;
+        let j = dc.index_of(cc.v[k]).expect("neighbours share a facet");
+        self.space.difference(cc.off[k], dc.off[j])
+    }
+
+    /// Exact orientation of a stored cell.
+    pub fn orientation(&self, c: u32) -> Sign {
+        self.space.orient(&self.lifted_cell(c))
+    }
+
+    /// Creates a cell, normalizing its offsets, and keeps the covering bookkeeping.
+    fn make_cell(&mut self, v: [u32; N], mut off: [S::Offset; N]) -> u32 {
+        self.space.normalize(&mut off, self.one_sheeted);
+        let id = self.tds.create(Cell::new(v, off));
+        if !self.one_sheeted {
+            let s: [Lifted<S::Point, S::Offset>; N] =
+                std::array::from_fn(|i| (self.points[self.vpoint[v[i] as usize] as usize], off[i]));
+            let big = self.space.circumradius2(&s) >= self.space.criterion_radius2();
+            if self.big.len() <= id as usize {
+                self.big.resize(id as usize + 1, false);
+            }
+            self.big[id as usize] = big;
+            self.big_count += big as usize;
+        }
+        id
+    }
+
+    /// Deletes a cell and keeps the covering bookkeeping.
+    fn kill_cell(&mut self, c: u32) {
+        if !self.one_sheeted && self.big[c as usize] {
+            self.big[c as usize] = false;
+            self.big_count -= 1;
+        }
+        self.tds.delete(c);
+    }
+
+    /// Points `vcell` of every vertex of `c` at `c`.
+    #[inline]
+    fn attach(&mut self, c: u32) {
+        let v = self.tds.cells[c as usize].v;
+        for x in v {
+            self.vcell[x as usize] = c;
+        }
+    }
+
+    /// Links facet `i` of `a` with facet `j` of `b`.
+    #[inline]
+    fn link(&mut self, a: u32, i: usize, b: u32, j: usize) {
+        self.tds.cells[a as usize].n[i] = b;
+        self.tds.cells[b as usize].n[j] = a;
+    }
+
+    /// A live cell to start a walk from.
+    fn start_cell(&self) -> u32 {
+        if self.hint != NONE
+            && (self.hint as usize) < self.tds.cells.len()
+            && self.tds.is_alive(self.hint)
+        {
+            self.hint
+        } else {
+            self.tds.ids().next().expect("a non-empty triangulation")
+        }
+    }
+}

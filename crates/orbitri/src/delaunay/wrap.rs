@@ -1,0 +1,266 @@
+//! Gift wrapping in the lifted space: closes open facets one by one with the Delaunay apex
+//! among given candidates (the pencil of spheres through a facet is totally ordered by the
+//! perturbed in-sphere test, so one pass finds the apex). It builds the first triangulation
+//! of a space and fills the hole left by a removed vertex.
+
+use std::collections::HashMap;
+
+use super::Engine;
+use crate::predicates::Sign;
+use crate::space::{Lifted, OrbitSpace};
+use crate::tds::NONE;
+
+/// Who is on the other side of an open facet.
+#[derive(Clone, Copy, Debug)]
+pub(super) enum Owner {
+    /// An existing cell and its facet index.
+    Old(u32, usize),
+    /// A new cell (index into the result) and its facet index.
+    New(usize, usize),
+}
+
+/// A facet waiting for its cell: the lifted simplex `arr` whose slot `idx` is to be
+/// replaced by the apex, on the side of `arr[idx]` when `toward`, else on the other side.
+struct Open<P, O, const N: usize> {
+    vids: [u32; N],
+    arr: [Lifted<P, O>; N],
+    idx: usize,
+    toward: bool,
+    owner: Owner,
+}
+
+/// A cell produced by wrapping, in the common frame of the candidates.
+#[derive(Clone, Debug)]
+pub(super) struct Wrapped<P, O, const N: usize> {
+    pub vids: [u32; N],
+    pub arr: [Lifted<P, O>; N],
+    pub links: [Option<Owner>; N],
+}
+
+fn facet_key<const N: usize>(vids: &[u32; N], skip: usize) -> [u32; N] {
+    let mut k = *vids;
+    k[skip] = NONE;
+    k.sort_unstable();
+    k
+}
+
+impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
+    /// The Delaunay apex for an open facet among `cands` (vertex id, lifted point).
+    fn pivot(
+        &self,
+        f: &Open<S::Point, S::Offset, N>,
+        cands: &[(u32, Lifted<S::Point, S::Offset>)],
+    ) -> Option<(u32, [Lifted<S::Point, S::Offset>; N])> {
+        let want = if f.toward {
+            Sign::Positive
+        } else {
+            Sign::Negative
+        };
+        let mut best: Option<(u32, [Lifted<S::Point, S::Offset>; N])> = None;
+        for &(vid, y) in cands {
+            if f.vids
+                .iter()
+                .enumerate()
+                .any(|(k, &v)| k != f.idx && v == vid)
+            {
+                continue;
+            }
+            let mut s = f.arr;
+            s[f.idx] = y;
+            if self.space.orient(&s) != want {
+                continue;
+            }
+            if !f.toward {
+                s.swap((f.idx + 1) % N, (f.idx + 2) % N);
+            }
+            match &best {
+                Some((_, b)) if self.space.in_sphere(b, y) != Sign::Positive => {}
+                _ => best = Some((vid, s)),
+            }
+        }
+        best
+    }
+
+    /// Closes every facet of `open` (and every facet the new cells leave open); the apex of
+    /// a facet is taken from `candidates(simplex, slot to replace)`. Returns the new cells with their links, or
+    /// `None` if some facet found no apex.
+    pub(super) fn wrap(
+        &self,
+        seeds: Vec<(
+            [u32; N],
+            [Lifted<S::Point, S::Offset>; N],
+            usize,
+            bool,
+            Owner,
+        )>,
+        mut candidates: impl FnMut(
+            &[Lifted<S::Point, S::Offset>; N],
+            usize,
+        ) -> Vec<(u32, Lifted<S::Point, S::Offset>)>,
+        mut first: Vec<Wrapped<S::Point, S::Offset, N>>,
+    ) -> Option<Vec<Wrapped<S::Point, S::Offset, N>>> {
+        let mut open: HashMap<[u32; N], Open<S::Point, S::Offset, N>> = HashMap::new();
+        let mut queue: Vec<[u32; N]> = Vec::new();
+        for (vids, arr, idx, toward, owner) in seeds {
+            let key = facet_key(&vids, idx);
+            queue.push(key);
+            open.insert(
+                key,
+                Open {
+                    vids,
+                    arr,
+                    idx,
+                    toward,
+                    owner,
+                },
+            );
+        }
+        while let Some(key) = queue.pop() {
+            let Some(f) = open.remove(&key) else { continue };
+            let cands = candidates(&f.arr, f.idx);
+            let (vid, arr) = self.pivot(&f, &cands)?;
+            let mut vids = f.vids;
+            vids[f.idx] = vid;
+            if !f.toward {
+                vids.swap((f.idx + 1) % N, (f.idx + 2) % N);
+            }
+            let k = first.len();
+            let mut links = [None; N];
+            links[f.idx] = Some(f.owner);
+            if let Owner::New(o, m) = f.owner {
+                first[o].links[m] = Some(Owner::New(k, f.idx));
+            }
+            for (m, link) in links.iter_mut().enumerate() {
+                if m == f.idx {
+                    continue;
+                }
+                let fk = facet_key(&vids, m);
+                if let Some(other) = open.remove(&fk) {
+                    *link = Some(other.owner);
+                    if let Owner::New(o, mm) = other.owner {
+                        first[o].links[mm] = Some(Owner::New(k, m));
+                    }
+                } else {
+                    queue.push(fk);
+                    open.insert(
+                        fk,
+                        Open {
+                            vids,
+                            arr,
+                            idx: m,
+                            toward: false,
+                            owner: Owner::New(k, m),
+                        },
+                    );
+                }
+            }
+            first.push(Wrapped { vids, arr, links });
+        }
+        Some(first)
+    }
+
+    /// Creates the wrapped cells and links them; returns their ids.
+    pub(super) fn commit(&mut self, cells: &[Wrapped<S::Point, S::Offset, N>]) -> Vec<u32> {
+        let ids: Vec<u32> = cells
+            .iter()
+            .map(|w| self.make_cell(w.vids, w.arr.map(|(_, o)| o)))
+            .collect();
+        for (k, w) in cells.iter().enumerate() {
+            for (m, link) in w.links.iter().enumerate() {
+                match link.expect("every facet is closed") {
+                    Owner::Old(d, j) => self.link(ids[k], m, d, j),
+                    Owner::New(o, j) => self.link(ids[k], m, ids[o], j),
+                }
+            }
+        }
+        for &id in &ids {
+            self.attach(id);
+        }
+        self.hint = ids[0];
+        ids
+    }
+
+    /// The first Delaunay cell with vertex `a`: the nearest candidates are tried first, and a
+    /// cell is accepted when it is positively oriented, small enough for the candidates to
+    /// cover its circumsphere, and empty.
+    pub(super) fn first_cell(
+        &self,
+        a: (u32, Lifted<S::Point, S::Offset>),
+        cands: &[(u32, Lifted<S::Point, S::Offset>)],
+        max_r2: f64,
+    ) -> Option<Wrapped<S::Point, S::Offset, N>> {
+        let others: Vec<(u32, Lifted<S::Point, S::Offset>)> =
+            cands.iter().copied().filter(|c| c.0 != a.0).collect();
+        let k = others.len();
+        let mut pick = vec![0usize; N - 1];
+        // enumerate (N−1)-subsets in colexicographic order: nearest candidates first
+        for (i, p) in pick.iter_mut().enumerate() {
+            *p = i;
+        }
+        if k < N - 1 {
+            return None;
+        }
+        loop {
+            let mut vids = [a.0; N];
+            let mut s = [a.1; N];
+            for (slot, &i) in pick.iter().enumerate() {
+                vids[slot + 1] = others[i].0;
+                s[slot + 1] = others[i].1;
+            }
+            let distinct = (0..N).all(|i| (i + 1..N).all(|j| vids[i] != vids[j]));
+            let o = if distinct {
+                self.space.orient(&s)
+            } else {
+                Sign::Zero
+            };
+            if o != Sign::Zero {
+                if o == Sign::Negative {
+                    s.swap(1, 2);
+                    vids.swap(1, 2);
+                }
+                if self.space.circumradius2(&s) <= max_r2
+                    && others.iter().all(|&(v, y)| {
+                        vids.contains(&v) || self.space.in_sphere(&s, y) != Sign::Positive
+                    })
+                {
+                    return Some(Wrapped {
+                        vids,
+                        arr: s,
+                        links: [None; N],
+                    });
+                }
+            }
+            // next subset in colex order
+            let mut i = 0;
+            while i < N - 1 {
+                let limit = if i + 1 < N - 1 { pick[i + 1] } else { k };
+                if pick[i] + 1 < limit {
+                    pick[i] += 1;
+                    for (j, p) in pick.iter_mut().enumerate().take(i) {
+                        *p = j;
+                    }
+                    break;
+                }
+                i += 1;
+            }
+            if i == N - 1 {
+                return None;
+            }
+        }
+    }
+
+    /// Seeds for wrapping outward from a first cell: its facets, owned by itself.
+    pub(super) fn seeds_of(
+        w: &Wrapped<S::Point, S::Offset, N>,
+    ) -> Vec<(
+        [u32; N],
+        [Lifted<S::Point, S::Offset>; N],
+        usize,
+        bool,
+        Owner,
+    )> {
+        (0..N)
+            .map(|m| (w.vids, w.arr, m, false, Owner::New(0, m)))
+            .collect()
+    }
+}

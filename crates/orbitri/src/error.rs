@@ -1,0 +1,41 @@
+//! The typed errors of the library: each names the offending place and value.
+
+use std::path::PathBuf;
+
+/// Everything that can go wrong, with the place (point index, file and line) and the value.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    #[error("point {index}: coordinate {axis} is {value}, not a finite number")]
+    NonFiniteCoordinate {
+        index: usize,
+        axis: usize,
+        value: f64,
+    },
+    #[error("the input holds no points")]
+    EmptyInput,
+    #[error("invalid box: {0}")]
+    InvalidBox(String),
+    #[error("singular lattice: the lattice vectors are linearly dependent (|det| = {det:e})")]
+    SingularLattice { det: f64 },
+    #[error(
+        "lattice too skewed: orthogonality defect {defect:.3} > {limit} (reduce the basis, e.g. keep tilt factors within half a box length)"
+    )]
+    SkewedLattice { defect: f64, limit: f64 },
+    #[error("expected points of dimension {expected}, got {found}")]
+    DimensionMismatch { expected: usize, found: usize },
+    #[error("{}:{line}: {message}", file.display())]
+    Parse {
+        file: PathBuf,
+        line: usize,
+        message: String,
+    },
+    #[error("{}: {source}", file.display())]
+    Io {
+        file: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+}
+
+/// The library's result type.
+pub type Result<T> = std::result::Result<T, Error>;

@@ -1,0 +1,29 @@
+//! orbitri: exact Delaunay triangulations of point sets in orbit spaces.
+//!
+//! The first orbit space is the 3D flat torus of any lattice (cube, cuboid, triclinic).
+//!
+//! ```
+//! use orbitri::{FlatTorus3, PeriodicDelaunay3};
+//! let torus = FlatTorus3::cuboid([1.0, 1.0, 1.0]).unwrap();
+//! let pts: Vec<[f64; 3]> = (0..200).map(|i| {
+//!     let f = i as f64;
+//!     [(f * 0.618034) % 1.0, (f * 0.414214) % 1.0, (f * 0.732051) % 1.0]
+//! }).collect();
+//! let tri = PeriodicDelaunay3::build(torus, &pts).unwrap();
+//! assert!(tri.is_valid().is_ok());
+//! assert_eq!(tri.number_of_vertices(), 200);
+//! ```
+
+pub mod delaunay;
+pub mod error;
+pub mod io;
+pub mod periodic3;
+pub mod predicates;
+pub mod sort;
+pub mod space;
+pub mod tds;
+
+pub use delaunay::{Engine, Inserted, Invalid};
+pub use error::{Error, Result};
+pub use periodic3::{BuildOptions, CellView, Copies, PeriodicDelaunay3, Simplex};
+pub use space::{FlatTorus3, Lattice, OrbitSpace};

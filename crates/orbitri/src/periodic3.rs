@@ -1,0 +1,411 @@
+//! `PeriodicDelaunay3`: the Delaunay triangulation of a point set in a 3D flat torus, with
+//! input bookkeeping (wrapping, duplicates), bulk construction and the access API.
+
+use std::collections::HashSet;
+
+use crate::delaunay::{Engine, Inserted, Invalid};
+use crate::error::{Error, Result};
+use crate::space::{FlatTorus3, OrbitSpace};
+use crate::tds::NONE;
+
+/// Offset of a vertex in lattice-vector units.
+pub type Offset = [i8; 3];
+
+/// Which copies an iterator yields in a multi-sheeted covering (CGAL's iterator types).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Copies {
+    /// One copy per simplex of the quotient.
+    Unique,
+    /// Every stored simplex of the covering space.
+    Stored,
+}
+
+/// A cell: input ids of its vertices and their offsets, positively oriented.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct CellView {
+    pub vertices: [u32; 4],
+    pub offsets: [Offset; 4],
+}
+
+/// A simplex of lower dimension (edge: 2 vertices, facet: 3), canonical: sorted by
+/// (vertex, offset) with the first offset translated to zero.
+#[derive(Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct Simplex {
+    pub vertices: Vec<u32>,
+    pub offsets: Vec<Offset>,
+}
+
+/// Options of the bulk construction.
+#[derive(Clone, Copy, Debug)]
+pub struct BuildOptions {
+    /// Start from the dummy point set when there are at least this many points.
+    pub dummy_threshold: usize,
+    /// Seed of the BRIO shuffle.
+    pub seed: u64,
+    /// Sort the points spatially (BRIO + Hilbert); otherwise insert in input order.
+    pub spatial_sort: bool,
+}
+
+impl Default for BuildOptions {
+    fn default() -> Self {
+        BuildOptions {
+            dummy_threshold: 1000,
+            seed: 0x0b17,
+            spatial_sort: true,
+        }
+    }
+}
+
+/// The periodic Delaunay triangulation of a 3D flat torus.
+#[derive(Debug)]
+pub struct PeriodicDelaunay3 {
+    engine: Engine<FlatTorus3, 4>,
+    /// Input index → point (vertex) index.
+    input_point: Vec<u32>,
+    /// Point index → input index of its first occurrence.
+    point_input: Vec<u32>,
+    wrapped: usize,
+    duplicates: usize,
+    used_dummies: bool,
+}
+
+fn check_finite(i: usize, p: &[f64; 3]) -> Result<()> {
+    for (axis, v) in p.iter().enumerate() {
+        if !v.is_finite() {
+            return Err(Error::NonFiniteCoordinate {
+                index: i,
+                axis,
+                value: *v,
+            });
+        }
+    }
+    Ok(())
+}
+
+impl PeriodicDelaunay3 {
+    /// An empty triangulation of the torus.
+    pub fn new(space: FlatTorus3) -> Self {
+        PeriodicDelaunay3 {
+            engine: Engine::new(space),
+            input_point: Vec::new(),
+            point_input: Vec::new(),
+            wrapped: 0,
+            duplicates: 0,
+            used_dummies: false,
+        }
+    }
+
+    /// Builds the triangulation of `points` (wrapped into the domain first).
+    pub fn build(space: FlatTorus3, points: &[[f64; 3]]) -> Result<Self> {
+        Self::build_with(space, points, BuildOptions::default(), |_| {})
+    }
+
+    /// Bulk construction: spatial sort (BRIO + Hilbert); for large inputs start from the
+    /// dummy point set in the 1-sheeted torus and remove the dummies at the end, otherwise
+    /// (or if removing a dummy would break the criterion) insert into the covering space.
+    /// `progress` is called with the number of points inserted so far.
+    pub fn build_with(
+        space: FlatTorus3,
+        points: &[[f64; 3]],
+        opts: BuildOptions,
+        progress: impl Fn(usize),
+    ) -> Result<Self> {
+        if points.is_empty() {
+            return Err(Error::EmptyInput);
+        }
+        let mut wrapped_pts = Vec::with_capacity(points.len());
+        let mut wrapped = 0;
+        for (i, p) in points.iter().enumerate() {
+            check_finite(i, p)?;
+            let (w, moved) = space.lattice().wrap(*p);
+            wrapped += moved as usize;
+            wrapped_pts.push(w);
+        }
+        let order: Vec<u32> = if opts.spatial_sort {
+            let keys: Vec<u64> = wrapped_pts.iter().map(|p| space.spatial_key(p)).collect();
+            crate::sort::brio_order(&keys, opts.seed)
+        } else {
+            (0..points.len() as u32).collect()
+        };
+        let mut tri = PeriodicDelaunay3::new(space.clone());
+        tri.wrapped = wrapped;
+        if points.len() >= opts.dummy_threshold
+            && tri.build_from_dummies(&wrapped_pts, &order, &progress)
+        {
+            return Ok(tri);
+        }
+        let mut tri = PeriodicDelaunay3::new(space);
+        tri.wrapped = wrapped;
+        tri.input_point = vec![NONE; points.len()];
+        for (k, &i) in order.iter().enumerate() {
+            tri.insert_wrapped(i as usize, wrapped_pts[i as usize]);
+            if k % 4096 == 0 {
+                progress(k);
+            }
+        }
+        if !tri.engine.is_one_sheeted() {
+            tri.engine.try_one_sheet();
+        }
+        progress(points.len());
+        Ok(tri)
+    }
+
+    /// Dummy-point construction; false if it had to be abandoned (a point coincides with a
+    /// dummy, or the points alone do not satisfy the criterion).
+    fn build_from_dummies(
+        &mut self,
+        pts: &[[f64; 3]],
+        order: &[u32],
+        progress: &impl Fn(usize),
+    ) -> bool {
+        let dummies = self.engine.space().dummy_points();
+        let k = dummies.len() as u32;
+        self.engine.points = dummies;
+        self.engine.bootstrap_one_sheeted();
+        self.input_point = vec![NONE; pts.len()];
+        for (n, &i) in order.iter().enumerate() {
+            match self.engine.insert(pts[i as usize]) {
+                Inserted::New(p) => {
+                    self.input_point[i as usize] = p;
+                    self.point_input.push(i);
+                }
+                Inserted::Duplicate(p) if p < k => return false,
+                Inserted::Duplicate(p) => {
+                    self.input_point[i as usize] = p;
+                    self.duplicates += 1;
+                }
+            }
+            if n % 4096 == 0 {
+                progress(n);
+            }
+        }
+        for d in 0..k {
+            if self.engine.remove_vertex(d).is_err() {
+                return false;
+            }
+        }
+        self.engine.drop_leading_points(k);
+        for p in self.input_point.iter_mut() {
+            *p -= k;
+        }
+        self.used_dummies = true;
+        progress(pts.len());
+        true
+    }
+
+    fn insert_wrapped(&mut self, i: usize, p: [f64; 3]) -> Inserted {
+        let r = self.engine.insert(p);
+        match r {
+            Inserted::New(v) => {
+                self.input_point[i] = v;
+                self.point_input.push(i as u32);
+            }
+            Inserted::Duplicate(v) => {
+                self.input_point[i] = v;
+                self.duplicates += 1;
+            }
+        }
+        r
+    }
+
+    /// Inserts one more point (wrapped into the domain); its input id is the number of
+    /// points given so far. Returns the vertex (point index) it became or coincides with.
+    pub fn insert(&mut self, p: [f64; 3]) -> Result<Inserted> {
+        let i = self.input_point.len();
+        check_finite(i, &p)?;
+        let (w, moved) = self.engine.space().lattice().wrap(p);
+        self.wrapped += moved as usize;
+        self.input_point.push(NONE);
+        Ok(self.insert_wrapped(i, w))
+    }
+
+    /// The orbit space.
+    pub fn space(&self) -> &FlatTorus3 {
+        self.engine.space()
+    }
+
+    /// The engine (for generic algorithms).
+    pub fn engine(&self) -> &Engine<FlatTorus3, 4> {
+        &self.engine
+    }
+
+    /// Sheets of the stored triangulation: 1 once it is a triangulation of the torus.
+    pub fn sheets(&self) -> usize {
+        self.engine.sheets()
+    }
+
+    /// True when the stored triangulation is the 1-sheeted quotient.
+    pub fn is_one_sheeted(&self) -> bool {
+        self.engine.is_one_sheeted()
+    }
+
+    /// True if the bulk construction started from the dummy point set.
+    pub fn used_dummy_points(&self) -> bool {
+        self.used_dummies
+    }
+
+    /// Number of input points given.
+    pub fn number_of_input_points(&self) -> usize {
+        self.input_point.len()
+    }
+
+    /// Number of distinct points (vertices of the quotient).
+    pub fn number_of_vertices(&self) -> usize {
+        self.engine.points().len()
+    }
+
+    /// Number of stored cells (in the covering: all copies).
+    pub fn number_of_cells(&self) -> usize {
+        self.engine.number_of_cells()
+    }
+
+    /// Number of input points that coincided with an earlier one.
+    pub fn duplicates(&self) -> usize {
+        self.duplicates
+    }
+
+    /// Number of input points that were wrapped into the domain.
+    pub fn wrapped(&self) -> usize {
+        self.wrapped
+    }
+
+    /// The distinct points (wrapped), indexed by vertex.
+    pub fn points(&self) -> &[[f64; 3]] {
+        self.engine.points()
+    }
+
+    /// The vertex of input point `i`.
+    pub fn vertex_of_input(&self, i: usize) -> u32 {
+        self.input_point[i]
+    }
+
+    /// The input id of vertex `v` (its first occurrence).
+    pub fn input_of_vertex(&self, v: u32) -> u32 {
+        self.point_input[v as usize]
+    }
+
+    /// For every input point, the input id of its first occurrence (itself unless duplicate).
+    pub fn first_occurrences(&self) -> Vec<u32> {
+        self.input_point
+            .iter()
+            .map(|&v| self.point_input[v as usize])
+            .collect()
+    }
+
+    fn view(&self, c: u32) -> CellView {
+        let cell = self.engine.cell(c);
+        CellView {
+            vertices: cell
+                .v
+                .map(|x| self.point_input[self.engine.point_of(x) as usize]),
+            offsets: cell.off,
+        }
+    }
+
+    /// The cells with input ids and offsets: every stored cell, or one per orbit.
+    pub fn cells(&self, copies: Copies) -> Vec<CellView> {
+        let stored: Vec<u32> = self.engine.cell_ids().collect();
+        if copies == Copies::Stored || self.is_one_sheeted() {
+            return stored.into_iter().map(|c| self.view(c)).collect();
+        }
+        let mut seen = HashSet::new();
+        stored
+            .into_iter()
+            .filter(|&c| seen.insert(canonical(&self.view(c).vertices, &self.view(c).offsets)))
+            .map(|c| self.view(c))
+            .collect()
+    }
+
+    /// Faces with `k` vertices (2: edges, 3: facets), each once (canonical form).
+    fn faces(&self, k: usize, copies: Copies) -> Vec<Simplex> {
+        let mut out: HashSet<Simplex> = HashSet::new();
+        for c in self.engine.cell_ids() {
+            let cell = self.engine.cell(c);
+            for mask in 0u32..16 {
+                if mask.count_ones() as usize != k {
+                    continue;
+                }
+                let idx: Vec<usize> = (0..4).filter(|i| mask >> i & 1 == 1).collect();
+                let (v, o): (Vec<u32>, Vec<Offset>) = match copies {
+                    Copies::Unique => idx
+                        .iter()
+                        .map(|&i| {
+                            (
+                                self.point_input[self.engine.point_of(cell.v[i]) as usize],
+                                cell.off[i],
+                            )
+                        })
+                        .unzip(),
+                    Copies::Stored => idx.iter().map(|&i| (cell.v[i], cell.off[i])).unzip(),
+                };
+                let (vertices, offsets) = canonical(&v, &o);
+                out.insert(Simplex { vertices, offsets });
+            }
+        }
+        let mut v: Vec<Simplex> = out.into_iter().collect();
+        v.sort_unstable();
+        v
+    }
+
+    /// The edges (input ids, offsets), each once; `Stored` lists covering copies by vertex id.
+    pub fn edges(&self, copies: Copies) -> Vec<Simplex> {
+        self.faces(2, copies)
+    }
+
+    /// The facets, each once; `Stored` lists covering copies by vertex id.
+    pub fn facets(&self, copies: Copies) -> Vec<Simplex> {
+        self.faces(3, copies)
+    }
+
+    /// The neighbours of input point `i`: (input id, offset of the neighbour relative to
+    /// the point), one entry per Delaunay edge at the point.
+    pub fn vertex_neighbors(&self, i: usize) -> Vec<(u32, Offset)> {
+        let me = self.point_input[self.input_point[i] as usize];
+        let mut out: Vec<(u32, Offset)> = self
+            .edges(Copies::Unique)
+            .into_iter()
+            .filter_map(|e| {
+                let s = self.space();
+                if e.vertices[0] == me && e.vertices[1] != me {
+                    Some((e.vertices[1], s.difference(e.offsets[1], e.offsets[0])))
+                } else if e.vertices[1] == me && e.vertices[0] != me {
+                    Some((e.vertices[0], s.difference(e.offsets[0], e.offsets[1])))
+                } else {
+                    None
+                }
+            })
+            .collect();
+        out.sort_unstable();
+        out
+    }
+
+    /// The cell containing `p` (wrapped into the domain) and the offset of `p` in its frame.
+    pub fn locate(&mut self, p: [f64; 3]) -> Result<(CellView, Offset)> {
+        if self.number_of_vertices() == 0 {
+            return Err(Error::EmptyInput);
+        }
+        check_finite(0, &p)?;
+        let (w, _) = self.engine.space().lattice().wrap(p);
+        let (c, o) = self.engine.locate(w);
+        Ok((self.view(c), o))
+    }
+
+    /// Checks combinatorics and geometry exactly.
+    pub fn is_valid(&self) -> std::result::Result<(), Invalid> {
+        self.engine.is_valid()
+    }
+}
+
+/// Canonical form of a simplex given by vertices and offsets: sorted pairs, translated so
+/// that the componentwise minimum offset is zero.
+fn canonical(v: &[u32], o: &[Offset]) -> (Vec<u32>, Vec<Offset>) {
+    let mut pairs: Vec<(u32, Offset)> = v.iter().copied().zip(o.iter().copied()).collect();
+    for c in 0..3 {
+        let m = pairs.iter().map(|p| p.1[c]).min().unwrap();
+        for p in pairs.iter_mut() {
+            p.1[c] -= m;
+        }
+    }
+    pairs.sort_unstable();
+    pairs.into_iter().unzip()
+}

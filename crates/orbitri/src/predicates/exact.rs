@@ -1,0 +1,149 @@
+//! Exact evaluation with big integers. Every finite double is `m·2^e` with an integer `m`;
+//! scaling all values of one predicate by the same power of two turns them into integers
+//! without changing any sign, so determinants are computed exactly on `BigInt`s.
+
+use num_bigint::BigInt;
+use num_traits::{Signed, Zero};
+
+use super::Sign;
+
+/// Splits a finite double into `(m, e)` with `x = m·2^e` and `m` odd (or zero).
+fn decompose(x: f64) -> (i64, i32) {
+    if x == 0.0 {
+        return (0, 0);
+    }
+    let bits = x.to_bits();
+    let sign = if bits >> 63 == 1 { -1 } else { 1 };
+    let exp = ((bits >> 52) & 0x7ff) as i32;
+    let frac = bits & ((1u64 << 52) - 1);
+    let (mut m, mut e) = if exp == 0 {
+        (frac as i64, -1074)
+    } else {
+        ((frac | (1u64 << 52)) as i64, exp - 1075)
+    };
+    let tz = m.trailing_zeros() as i32;
+    m >>= tz;
+    e += tz;
+    (sign * m, e)
+}
+
+/// A set of doubles brought to a common scale `2^emin`, as big integers.
+pub struct Scaled {
+    emin: i32,
+}
+
+impl Scaled {
+    /// The common scale of `values` (all finite).
+    pub fn new(values: impl IntoIterator<Item = f64>) -> Scaled {
+        let emin = values
+            .into_iter()
+            .filter(|v| *v != 0.0)
+            .map(|v| decompose(v).1)
+            .min()
+            .unwrap_or(0);
+        Scaled { emin }
+    }
+
+    /// `x / 2^emin` as an exact integer.
+    pub fn int(&self, x: f64) -> BigInt {
+        let (m, e) = decompose(x);
+        BigInt::from(m) << ((e - self.emin) as usize)
+    }
+}
+
+/// The sign of a big integer.
+pub fn sign(x: &BigInt) -> Sign {
+    if x.is_zero() {
+        Sign::Zero
+    } else if x.is_positive() {
+        Sign::Positive
+    } else {
+        Sign::Negative
+    }
+}
+
+/// `det [a; b; c]` of three rows.
+pub fn det3(a: &[BigInt; 3], b: &[BigInt; 3], c: &[BigInt; 3]) -> BigInt {
+    &a[0] * (&b[1] * &c[2] - &b[2] * &c[1]) - &a[1] * (&b[0] * &c[2] - &b[2] * &c[0])
+        + &a[2] * (&b[0] * &c[1] - &b[1] * &c[0])
+}
+
+/// `det [a; b]` of two rows.
+pub fn det2(a: &[BigInt; 2], b: &[BigInt; 2]) -> BigInt {
+    &a[0] * &b[1] - &a[1] * &b[0]
+}
+
+/// Determinant of a square matrix given by rows (Laplace expansion along the first row;
+/// only used for the sizes 3 and 4 of the in-sphere tests).
+pub fn det(rows: &[Vec<BigInt>]) -> BigInt {
+    let n = rows.len();
+    if n == 1 {
+        return rows[0][0].clone();
+    }
+    if n == 2 {
+        return &rows[0][0] * &rows[1][1] - &rows[0][1] * &rows[1][0];
+    }
+    let mut total = BigInt::zero();
+    for col in 0..n {
+        if rows[0][col].is_zero() {
+            continue;
+        }
+        let minor: Vec<Vec<BigInt>> = rows[1..]
+            .iter()
+            .map(|r| {
+                r.iter()
+                    .enumerate()
+                    .filter(|(j, _)| *j != col)
+                    .map(|(_, v)| v.clone())
+                    .collect()
+            })
+            .collect();
+        let term = &rows[0][col] * det(&minor);
+        if col % 2 == 0 {
+            total += term;
+        } else {
+            total -= term;
+        }
+    }
+    total
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn decompose_round_trips() {
+        for x in [1.0, -3.5, 0.1, 1e-310, 5e-324, f64::MAX, -2.0f64.powi(-60)] {
+            let (m, e) = decompose(x);
+            assert_eq!(m as f64 * 2f64.powi(e), x, "{x}");
+            assert!(m % 2 != 0);
+        }
+    }
+
+    #[test]
+    fn scaled_integers_are_exact() {
+        let s = Scaled::new([0.5, 0.25, 3.0]);
+        assert_eq!(s.int(0.25), BigInt::from(1));
+        assert_eq!(s.int(3.0), BigInt::from(12));
+    }
+
+    #[test]
+    fn determinants() {
+        let m = |v: &[i64]| v.iter().map(|&x| BigInt::from(x)).collect::<Vec<_>>();
+        let rows = vec![m(&[2, 0, 1]), m(&[1, 3, 2]), m(&[1, 1, 2])];
+        assert_eq!(det(&rows), BigInt::from(6));
+        let a = [BigInt::from(2), BigInt::from(0), BigInt::from(1)];
+        let b = [BigInt::from(1), BigInt::from(3), BigInt::from(2)];
+        let c = [BigInt::from(1), BigInt::from(1), BigInt::from(2)];
+        assert_eq!(det3(&a, &b, &c), BigInt::from(6));
+        assert_eq!(
+            det2(
+                &[BigInt::from(1), BigInt::from(2)],
+                &[BigInt::from(3), BigInt::from(4)]
+            ),
+            BigInt::from(-2)
+        );
+        assert_eq!(sign(&BigInt::from(-4)), Sign::Negative);
+    }
+}

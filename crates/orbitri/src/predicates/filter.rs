@@ -1,0 +1,211 @@
+//! Floating-point evaluation of lifted differences and determinants with certified error
+//! bounds. Each function returns `None` when the bound cannot certify the sign.
+
+use super::Sign;
+
+const U: f64 = f64::EPSILON * 0.5;
+/// Rows whose magnitude bound lies outside this range skip the filter (no underflow or
+/// overflow can then occur in a degree-5 product).
+const TINY: f64 = 6.223015277861142e-61; // 2^-200
+const HUGE: f64 = 1.606938044258990e60; // 2^200
+
+/// A lattice given by its rows (the lattice vectors), as the predicates need it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Rows<const D: usize> {
+    pub m: [[f64; D]; D],
+    /// True when the matrix is diagonal (cube or cuboid): the lattice sum is one product.
+    pub diagonal: bool,
+}
+
+impl<const D: usize> Rows<D> {
+    /// `t·M` for an integer offset vector, each component with the sum of the absolute
+    /// values of its terms (the magnitude the error bound is relative to).
+    #[inline]
+    pub fn apply(&self, t: [i32; D]) -> ([f64; D], [f64; D]) {
+        let mut s = [0.0; D];
+        let mut a = [0.0; D];
+        if self.diagonal {
+            for c in 0..D {
+                s[c] = t[c] as f64 * self.m[c][c];
+                a[c] = s[c].abs();
+            }
+        } else {
+            for (k, row) in self.m.iter().enumerate() {
+                if t[k] == 0 {
+                    continue;
+                }
+                let tk = t[k] as f64;
+                for c in 0..D {
+                    let v = tk * row[c];
+                    s[c] += v;
+                    a[c] += v.abs();
+                }
+            }
+        }
+        (s, a)
+    }
+}
+
+/// The lifted difference `(p + t·M) − (p0 + t0·M)` and a bound `B` such that every component
+/// is off by at most `6u·B` and at most `B(1+u)` in magnitude.
+#[inline]
+pub fn lifted_diff<const D: usize>(
+    rows: &Rows<D>,
+    p: &[f64; D],
+    t: [i32; D],
+    p0: &[f64; D],
+    t0: [i32; D],
+) -> ([f64; D], f64) {
+    let mut d = [0.0; D];
+    let mut dt = [0i32; D];
+    let mut any = false;
+    for c in 0..D {
+        d[c] = p[c] - p0[c];
+        dt[c] = t[c] - t0[c];
+        any |= dt[c] != 0;
+    }
+    let mut b = 0.0f64;
+    if any {
+        let (s, a) = rows.apply(dt);
+        for c in 0..D {
+            let bc = d[c].abs() + a[c];
+            d[c] += s[c];
+            b = b.max(bc);
+        }
+    } else {
+        for v in &d {
+            b = b.max(v.abs());
+        }
+    }
+    (d, b)
+}
+
+#[inline]
+fn in_range(b: f64) -> bool {
+    (TINY..=HUGE).contains(&b) || b == 0.0
+}
+
+#[inline]
+fn det3(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> f64 {
+    a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+        + a[2] * (b[0] * c[1] - b[1] * c[0])
+}
+
+/// Orientation of the tetrahedron with edge vectors `d1, d2, d3` (bounds `b`).
+///
+/// Bound: each of the 6 products of three entries is off by at most `((1+6u)³−1)·B₁B₂B₃(1+u)³
+/// ≤ 18.1u·B₁B₂B₃` from the inputs and by at most `5u·B₁B₂B₃` from its own evaluation (two
+/// products, one difference, one product, two sums); `6·(18.1+5) < 160`.
+#[inline]
+pub fn orient3(d: &[[f64; 3]; 3], b: [f64; 3]) -> Option<Sign> {
+    if !(in_range(b[0]) && in_range(b[1]) && in_range(b[2])) {
+        return None;
+    }
+    let det = det3(&d[0], &d[1], &d[2]);
+    let err = 160.0 * U * b[0] * b[1] * b[2];
+    if det > err {
+        Some(Sign::Positive)
+    } else if det < -err {
+        Some(Sign::Negative)
+    } else if err == 0.0 {
+        // All rows are exactly zero vectors: the determinant is exactly zero.
+        Some(Sign::Zero)
+    } else {
+        None
+    }
+}
+
+/// In-sphere determinant for rows `d_i = a_i − q` (bounds `b`): positive when `q` is inside
+/// the sphere of the positively oriented `a_0..a_3`.
+///
+/// Bound: the 24 terms `l_i·(three entries of the other rows)` are each at most
+/// `3·B_max·ΠB` in magnitude; relative to that, the inputs contribute `3·6u + 15u` (`l_i` is
+/// a sum of three squares, each off by `12u·B²`, plus `3u` to evaluate) and the evaluation
+/// about `10u`; `72·(43u)·B_max·ΠB < 4096u·B_max·ΠB`.
+#[inline]
+pub fn in_sphere3(d: &[[f64; 3]; 4], b: [f64; 4]) -> Option<Sign> {
+    if !b.iter().all(|&x| in_range(x)) {
+        return None;
+    }
+    let l: [f64; 4] =
+        std::array::from_fn(|i| d[i][0] * d[i][0] + d[i][1] * d[i][1] + d[i][2] * d[i][2]);
+    let det = -l[0] * det3(&d[1], &d[2], &d[3]) + l[1] * det3(&d[0], &d[2], &d[3])
+        - l[2] * det3(&d[0], &d[1], &d[3])
+        + l[3] * det3(&d[0], &d[1], &d[2]);
+    let bmax = b[0].max(b[1]).max(b[2]).max(b[3]);
+    let err = 4096.0 * U * bmax * b[0] * b[1] * b[2] * b[3];
+    // inside ⇔ det < 0 for this row layout
+    if det < -err {
+        Some(Sign::Positive)
+    } else if det > err {
+        Some(Sign::Negative)
+    } else {
+        None
+    }
+}
+
+/// Sign of one lifted coordinate difference component with its bound, or `None`.
+#[inline]
+pub fn component(d: f64, b: f64) -> Option<Sign> {
+    let err = 6.0 * U * b;
+    if d > err {
+        Some(Sign::Positive)
+    } else if d < -err {
+        Some(Sign::Negative)
+    } else if b == 0.0 {
+        Some(Sign::Zero)
+    } else {
+        None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn unit_tetrahedron_signs() {
+        let d = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        assert_eq!(orient3(&d, [1.0; 3]), Some(Sign::Positive));
+        let q = [0.25, 0.25, 0.25];
+        let a = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+        ];
+        let rows: [[f64; 3]; 4] = std::array::from_fn(|i| std::array::from_fn(|c| a[i][c] - q[c]));
+        assert_eq!(in_sphere3(&rows, [1.0; 4]), Some(Sign::Positive));
+        let far: [[f64; 3]; 4] = std::array::from_fn(|i| std::array::from_fn(|c| a[i][c] - 5.0));
+        assert_eq!(in_sphere3(&far, [6.0; 4]), Some(Sign::Negative));
+    }
+
+    #[test]
+    fn near_degenerate_is_undecided() {
+        // four coplanar points: the filter must not claim a sign
+        let d = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0]];
+        assert_eq!(orient3(&d, [1.0; 3]), None);
+        assert_eq!(component(1e-30, 1.0), None);
+        assert_eq!(component(0.5, 1.0), Some(Sign::Positive));
+    }
+
+    #[test]
+    fn lattice_sums() {
+        let r = Rows {
+            m: [[1.0, 0.0, 0.0], [0.5, 1.0, 0.0], [0.0, 0.0, 2.0]],
+            diagonal: false,
+        };
+        let (s, a) = r.apply([1, -2, 1]);
+        assert_eq!(s, [0.0, -2.0, 2.0]);
+        assert_eq!(a, [2.0, 2.0, 2.0]);
+        let (d, b) = lifted_diff(
+            &r,
+            &[0.25, 0.5, 0.5],
+            [1, 0, 0],
+            &[0.25, 0.5, 0.5],
+            [0, 0, 0],
+        );
+        assert_eq!(d, [1.0, 0.0, 0.0]);
+        assert_eq!(b, 1.0);
+    }
+}

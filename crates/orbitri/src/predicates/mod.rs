@@ -1,0 +1,56 @@
+//! Exact geometric predicates on lifted points `p + o·M` (a point of the domain plus a lattice
+//! offset), never rounded: a floating-point filter with a proven error bound first, an exact
+//! big-integer evaluation when the filter cannot decide, and the symbolic perturbation of
+//! Devillers and Teillaud for cospherical ties.
+//!
+//! Error bounds (u = 2⁻⁵³). A lifted difference component `d = (p_i − p_0) + Σ_k t_k M_kc`
+//! is evaluated as `fl(fl(p_i − p_0) + fl(Σ t_k M_kc))`; with `B = |fl(p_i − p_0)| + Σ |t_k M_kc|`
+//! its absolute error is below `6u·B` (one rounding in the difference, at most three in the
+//! lattice sum, one in the final addition, and one for evaluating `B` itself). The determinants
+//! are then bounded term by term in [`filter`]; inputs outside `[2⁻²⁰⁰, 2²⁰⁰]` per row skip the
+//! filter, so no intermediate value can underflow or overflow.
+
+pub mod exact;
+pub mod filter;
+
+/// The sign of a predicate.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Sign {
+    Negative,
+    Zero,
+    Positive,
+}
+
+impl Sign {
+    /// The sign of a floating-point value (`NaN` is never passed here).
+    #[inline]
+    pub fn of(x: f64) -> Sign {
+        if x > 0.0 {
+            Sign::Positive
+        } else if x < 0.0 {
+            Sign::Negative
+        } else {
+            Sign::Zero
+        }
+    }
+
+    /// The opposite sign.
+    #[inline]
+    pub fn flip(self) -> Sign {
+        match self {
+            Sign::Negative => Sign::Positive,
+            Sign::Zero => Sign::Zero,
+            Sign::Positive => Sign::Negative,
+        }
+    }
+}
+
+impl From<std::cmp::Ordering> for Sign {
+    fn from(o: std::cmp::Ordering) -> Sign {
+        match o {
+            std::cmp::Ordering::Less => Sign::Negative,
+            std::cmp::Ordering::Equal => Sign::Zero,
+            std::cmp::Ordering::Greater => Sign::Positive,
+        }
+    }
+}

@@ -1,0 +1,391 @@
+//! A lattice of translations in `D` dimensions: validation, fractional coordinates and
+//! wrapping into the half-open domain, the systole, and the choice of covering space and
+//! dummy point set that Algorithm 2.3.1 needs for an arbitrary lattice.
+
+use crate::error::{Error, Result};
+use crate::predicates::filter::Rows;
+
+/// Largest accepted orthogonality defect `Π|b_i| / |det|`. Within it, the coefficients of a
+/// shortest lattice vector are bounded by the defect, so enumerating `|x_i| ≤ 4` finds it.
+pub const MAX_DEFECT: f64 = 4.0;
+const ENUM: i32 = 4;
+
+/// A lattice given by `D` linearly independent row vectors; the domain is
+/// `{ f·M : f ∈ [0,1)^D }`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Lattice<const D: usize> {
+    pub(crate) rows: Rows<D>,
+    inv: [[f64; D]; D],
+    systole: f64,
+    volume: f64,
+}
+
+impl<const D: usize> Lattice<D> {
+    /// An axis-aligned box `[0,L_0) × … × [0,L_{D−1})`.
+    pub fn cuboid(lengths: [f64; D]) -> Result<Self> {
+        for (i, l) in lengths.iter().enumerate() {
+            if !l.is_finite() || *l <= 0.0 {
+                return Err(Error::InvalidBox(format!(
+                    "length {i} is {l}; box lengths must be positive and finite"
+                )));
+            }
+        }
+        let mut m = [[0.0; D]; D];
+        for i in 0..D {
+            m[i][i] = lengths[i];
+        }
+        Self::build(m, true)
+    }
+
+    /// A general lattice; `rows[i]` is the i-th lattice vector.
+    pub fn new(rows: [[f64; D]; D]) -> Result<Self> {
+        for (i, r) in rows.iter().enumerate() {
+            for (j, v) in r.iter().enumerate() {
+                if !v.is_finite() {
+                    return Err(Error::InvalidBox(format!(
+                        "lattice vector {i}, component {j} is {v}"
+                    )));
+                }
+            }
+            if r.iter().all(|v| *v == 0.0) {
+                return Err(Error::InvalidBox(format!("lattice vector {i} is zero")));
+            }
+        }
+        let diagonal = (0..D).all(|i| (0..D).all(|j| i == j || rows[i][j] == 0.0));
+        if diagonal && (0..D).any(|i| rows[i][i] < 0.0) {
+            let mut l = [0.0; D];
+            for i in 0..D {
+                l[i] = rows[i][i].abs();
+            }
+            return Self::cuboid(l);
+        }
+        Self::build(rows, diagonal)
+    }
+
+    fn build(m: [[f64; D]; D], diagonal: bool) -> Result<Self> {
+        let (det, inv) = invert(&m);
+        let norms: f64 = m.iter().map(|r| norm(r)).product();
+        if det == 0.0 || !det.is_finite() || det.abs() <= 1e-12 * norms {
+            return Err(Error::SingularLattice { det: det.abs() });
+        }
+        let defect = norms / det.abs();
+        if defect > MAX_DEFECT {
+            return Err(Error::SkewedLattice {
+                defect,
+                limit: MAX_DEFECT,
+            });
+        }
+        let rows = Rows { m, diagonal };
+        let systole = shortest_vector(&rows, [1; D]);
+        Ok(Lattice {
+            rows,
+            inv,
+            systole,
+            volume: det.abs(),
+        })
+    }
+
+    /// The lattice vectors (rows).
+    pub fn vectors(&self) -> [[f64; D]; D] {
+        self.rows.m
+    }
+
+    /// True for an axis-aligned box.
+    pub fn is_cuboid(&self) -> bool {
+        self.rows.diagonal
+    }
+
+    /// Length of the shortest non-zero lattice vector (δ).
+    pub fn systole(&self) -> f64 {
+        self.systole
+    }
+
+    /// Volume (area in 2D) of the domain.
+    pub fn volume(&self) -> f64 {
+        self.volume
+    }
+
+    /// Fractional (lattice) coordinates `x·M⁻¹`, approximately.
+    pub fn fractional(&self, x: &[f64; D]) -> [f64; D] {
+        let mut f = [0.0; D];
+        for (c, fc) in f.iter_mut().enumerate() {
+            for k in 0..D {
+                *fc += x[k] * self.inv[k][c];
+            }
+        }
+        f
+    }
+
+    /// Cartesian coordinates of fractional coordinates.
+    pub fn cartesian(&self, f: &[f64; D]) -> [f64; D] {
+        let mut x = [0.0; D];
+        for (k, fk) in f.iter().enumerate() {
+            for (c, xc) in x.iter_mut().enumerate() {
+                *xc += fk * self.rows.m[k][c];
+            }
+        }
+        x
+    }
+
+    /// Wraps a point into the half-open domain. Returns the wrapped point and whether it moved.
+    /// For a box, the result lies exactly in `[0, L)` per axis (a point on the upper face goes
+    /// to 0); for a triclinic lattice the domain test uses rounded fractional coordinates.
+    pub fn wrap(&self, x: [f64; D]) -> ([f64; D], bool) {
+        if self.rows.diagonal {
+            let mut y = x;
+            let mut moved = false;
+            for (c, yc) in y.iter_mut().enumerate() {
+                let l = self.rows.m[c][c];
+                if *yc >= 0.0 && *yc < l {
+                    continue;
+                }
+                moved = true;
+                let mut v = *yc - (*yc / l).floor() * l;
+                if v >= l {
+                    v -= l;
+                }
+                if v < 0.0 {
+                    v += l;
+                    if v >= l {
+                        v = 0.0;
+                    }
+                }
+                *yc = v;
+            }
+            return (y, moved);
+        }
+        let mut y = x;
+        let mut moved = false;
+        for _ in 0..4 {
+            let f = self.fractional(&y);
+            if f.iter().all(|v| (0.0..1.0).contains(v)) {
+                break;
+            }
+            moved = true;
+            let mut shift = [0.0; D];
+            for c in 0..D {
+                let k = f[c].floor();
+                // A coordinate that floors to 0 but rounds to 1 sits on the upper face.
+                shift[c] = if k == 0.0 && f[c] >= 1.0 { 1.0 } else { k };
+            }
+            let s = self.cartesian(&shift);
+            for c in 0..D {
+                y[c] -= s[c];
+            }
+        }
+        (y, moved)
+    }
+
+    /// The covering used for tiny point sets: `h_i` copies along lattice vector `i` such that
+    /// the systole of the sublattice `{Σ h_i x_i b_i}` exceeds twice the largest empty-ball
+    /// diameter a single point can leave, `√(Σ|b_i|²)` (covering radius ≤ ½√(Σ|b_i*|²));
+    /// Corollary 9 of Caroli–Teillaud then makes the covering a triangulation for any point
+    /// set (Lemma 2.3.8 of the thesis for cuboids). A cube uses 3 per axis (Theorem 2.2.8).
+    pub fn covering(&self) -> [i32; D] {
+        let l0 = self.rows.m[0][0];
+        if self.rows.diagonal && (0..D).all(|i| self.rows.m[i][i] == l0) {
+            return [3; D];
+        }
+        let big = 2.0 * self.rows.m.iter().map(|r| dot(r, r)).sum::<f64>().sqrt();
+        let mut best: Option<([i32; D], i64)> = None;
+        let mut h = [1i32; D];
+        loop {
+            let sheets: i64 = h.iter().map(|&v| v as i64).product();
+            if best.map_or(true, |(_, s)| sheets < s)
+                && shortest_vector(&self.rows, h) > big * (1.0 + 1e-9)
+            {
+                best = Some((h, sheets));
+            }
+            let mut i = 0;
+            while i < D {
+                h[i] += 1;
+                if h[i] <= 8 {
+                    break;
+                }
+                h[i] = 1;
+                i += 1;
+            }
+            if i == D {
+                break;
+            }
+        }
+        best.expect("a covering with at most 8 copies per axis exists for defect ≤ 4")
+            .0
+    }
+
+    /// A jittered grid of `Π k_i` dummy points in fractional coordinates whose largest empty
+    /// ball has diameter below `δ/2`: with `S = √(Σ|b_i/k_i|²)` the grid's empty balls have
+    /// diameter at most `S`, the jitter (2% of a grid step per axis) adds at most `0.04·S`,
+    /// and `k_i` is chosen so that `1.04·S < δ/2`.
+    pub fn dummy_grid(&self) -> Vec<[f64; D]> {
+        let mut k = [0usize; D];
+        for i in 0..D {
+            let x = norm(&self.rows.m[i]) * (D as f64).sqrt() * 2.0 * 1.04 / self.systole;
+            k[i] = (x.floor() as usize + 1).max(2);
+        }
+        let total: usize = k.iter().product();
+        let mut rng = crate::sort::SplitMix::new(0x0b17_2a11);
+        let mut out = Vec::with_capacity(total);
+        for idx in 0..total {
+            let mut rem = idx;
+            let mut f = [0.0; D];
+            for i in 0..D {
+                let g = rem % k[i];
+                rem /= k[i];
+                let jitter = 0.02 * (2.0 * rng.unit() - 1.0);
+                f[i] = (g as f64 + 0.5 + jitter) / k[i] as f64;
+            }
+            out.push(self.wrap(self.cartesian(&f)).0);
+        }
+        out
+    }
+}
+
+fn dot<const D: usize>(a: &[f64; D], b: &[f64; D]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+fn norm<const D: usize>(a: &[f64; D]) -> f64 {
+    dot(a, a).sqrt()
+}
+
+/// Shortest non-zero vector of the lattice spanned by `h_i·b_i` (enumeration, exact for
+/// bases with orthogonality defect at most [`MAX_DEFECT`]).
+fn shortest_vector<const D: usize>(rows: &Rows<D>, h: [i32; D]) -> f64 {
+    let side = (2 * ENUM + 1) as usize;
+    let total = side.pow(D as u32);
+    let mut best = f64::INFINITY;
+    for idx in 0..total {
+        let mut rem = idx;
+        let mut t = [0i32; D];
+        for tc in t.iter_mut() {
+            *tc = (rem % side) as i32 - ENUM;
+            rem /= side;
+        }
+        if t.iter().all(|&v| v == 0) {
+            continue;
+        }
+        let mut v = [0.0; D];
+        for k in 0..D {
+            for c in 0..D {
+                v[c] += (t[k] * h[k]) as f64 * rows.m[k][c];
+            }
+        }
+        best = best.min(norm(&v));
+    }
+    best
+}
+
+/// Determinant and inverse by Gauss–Jordan elimination with partial pivoting.
+fn invert<const D: usize>(m: &[[f64; D]; D]) -> (f64, [[f64; D]; D]) {
+    let mut a = *m;
+    let mut inv = [[0.0; D]; D];
+    for (i, r) in inv.iter_mut().enumerate() {
+        r[i] = 1.0;
+    }
+    let mut det = 1.0;
+    for col in 0..D {
+        let piv = (col..D)
+            .max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))
+            .unwrap();
+        if a[piv][col] == 0.0 {
+            return (0.0, inv);
+        }
+        if piv != col {
+            a.swap(piv, col);
+            inv.swap(piv, col);
+            det = -det;
+        }
+        let p = a[col][col];
+        det *= p;
+        for j in 0..D {
+            a[col][j] /= p;
+            inv[col][j] /= p;
+        }
+        for r in 0..D {
+            if r != col {
+                let f = a[r][col];
+                if f != 0.0 {
+                    for j in 0..D {
+                        a[r][j] -= f * a[col][j];
+                        inv[r][j] -= f * inv[col][j];
+                    }
+                }
+            }
+        }
+    }
+    (det, inv)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cube_uses_27_sheets_and_cuboid_lemma_2_3_8() {
+        assert_eq!(
+            Lattice::cuboid([1.0, 1.0, 1.0]).unwrap().covering(),
+            [3, 3, 3]
+        );
+        // Lemma 2.3.8: h_i > 2‖c‖/c_i for c = (1, 1, 2): ‖c‖ = √6 → h = (5, 5, 3)
+        assert_eq!(
+            Lattice::cuboid([1.0, 1.0, 2.0]).unwrap().covering(),
+            [5, 5, 3]
+        );
+    }
+
+    #[test]
+    fn bad_boxes_are_rejected() {
+        assert!(matches!(
+            Lattice::cuboid([1.0, 0.0, 1.0]),
+            Err(Error::InvalidBox(_))
+        ));
+        assert!(matches!(
+            Lattice::cuboid([1.0, -2.0, 1.0]),
+            Err(Error::InvalidBox(_))
+        ));
+        assert!(matches!(
+            Lattice::cuboid([1.0, f64::NAN, 1.0]),
+            Err(Error::InvalidBox(_))
+        ));
+        let singular = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0]];
+        assert!(matches!(
+            Lattice::new(singular),
+            Err(Error::SingularLattice { .. })
+        ));
+        let skewed = [[1.0, 0.0, 0.0], [10.0, 0.1, 0.0], [0.0, 0.0, 1.0]];
+        assert!(matches!(
+            Lattice::new(skewed),
+            Err(Error::SkewedLattice { .. })
+        ));
+    }
+
+    #[test]
+    fn systole_and_volume_of_triclinic() {
+        let l = Lattice::new([[1.0, 0.0, 0.0], [0.5, 1.0, 0.0], [0.3, 0.2, 0.9]]).unwrap();
+        assert!((l.volume() - 0.9).abs() < 1e-12);
+        assert!((l.systole() - 0.9f64.hypot(0.2).hypot(0.3).min(1.0)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn wrapping_lands_in_the_half_open_domain() {
+        let b = Lattice::cuboid([1.0, 2.0, 1.0]).unwrap();
+        assert_eq!(b.wrap([1.0, 2.0, -1e-20]), ([0.0, 0.0, 0.0], true));
+        assert_eq!(b.wrap([0.5, 0.5, 0.5]), ([0.5, 0.5, 0.5], false));
+        assert_eq!(b.wrap([-0.25, 4.5, 3.75]).0, [0.75, 0.5, 0.75]);
+        let t = Lattice::new([[1.0, 0.0, 0.0], [0.5, 1.0, 0.0], [0.3, 0.2, 0.9]]).unwrap();
+        for x in [[2.3, -1.7, 5.1], [-0.1, -0.1, -0.1], [1.8, 1.2, 0.95]] {
+            let (y, _) = t.wrap(x);
+            let f = t.fractional(&y);
+            assert!(f.iter().all(|v| (-1e-12..1.0).contains(v)), "{f:?}");
+            // y − x is a lattice vector
+            let d = t.fractional(&[y[0] - x[0], y[1] - x[1], y[2] - x[2]]);
+            assert!(d.iter().all(|v| (v - v.round()).abs() < 1e-9));
+        }
+    }
+
+    #[test]
+    fn dummy_grid_size() {
+        assert_eq!(Lattice::cuboid([1.0; 3]).unwrap().dummy_grid().len(), 64);
+    }
+}

@@ -1,0 +1,85 @@
+//! Orbit spaces as plug-ins of the engine: each knows its group elements (offsets), its exact
+//! predicates on lifted points, its covering space and its switch criterion.
+
+mod flat_torus;
+mod lattice;
+
+pub use flat_torus::FlatTorus3;
+pub use lattice::Lattice;
+
+use crate::predicates::Sign;
+use std::fmt::Debug;
+use std::hash::Hash;
+
+/// A point of the domain together with the group element that lifts it into the universal
+/// cover: for a flat torus, the lifted point is `p + o·M`.
+pub type Lifted<P, O> = (P, O);
+
+/// An orbit space whose triangulations have cells of `N` vertices.
+pub trait OrbitSpace<const N: usize>: Sync + Send {
+    /// A point of the fundamental domain.
+    type Point: Copy + Debug + PartialEq + Send + Sync;
+    /// A group element, as stored per cell vertex (flat torus: an integer offset vector).
+    type Offset: Copy + Debug + Eq + Hash + Ord + Default + Send + Sync;
+
+    /// `a + b` in the group.
+    fn compose(&self, a: Self::Offset, b: Self::Offset) -> Self::Offset;
+    /// `a − b` in the group.
+    fn difference(&self, a: Self::Offset, b: Self::Offset) -> Self::Offset;
+    /// Exact orientation of the lifted simplex.
+    fn orient(&self, s: &[Lifted<Self::Point, Self::Offset>; N]) -> Sign;
+    /// Exact, symbolically perturbed in-sphere test: `Positive` when `q` is inside the
+    /// circumsphere of the positively oriented `s`, never `Zero` for a point distinct from
+    /// the vertices. The perturbation depends only on the lifted positions, so every
+    /// periodic copy of a configuration gets the same answer.
+    fn in_sphere(
+        &self,
+        s: &[Lifted<Self::Point, Self::Offset>; N],
+        q: Lifted<Self::Point, Self::Offset>,
+    ) -> Sign;
+    /// Exact test whether two lifted points coincide.
+    fn coincide(
+        &self,
+        a: Lifted<Self::Point, Self::Offset>,
+        b: Lifted<Self::Point, Self::Offset>,
+    ) -> bool;
+    /// Approximate squared circumradius (infinite for a flat simplex).
+    fn circumradius2(&self, s: &[Lifted<Self::Point, Self::Offset>; N]) -> f64;
+    /// Squared circumradius below which every cell is safe for the 1-sheeted quotient
+    /// (Corollary 9 of Caroli–Teillaud: `Δ < δ/2`, i.e. radius `< δ/4`), with a safety margin.
+    fn criterion_radius2(&self) -> f64;
+    /// The offsets of the copies of one point in the initial covering space (one per sheet).
+    fn covering_copies(&self) -> Vec<Self::Offset>;
+    /// Translates a cell's offsets by a group element of the triangulated space (the covering
+    /// lattice, or the lattice itself once 1-sheeted) into canonical form.
+    fn normalize(&self, off: &mut [Self::Offset; N], one_sheeted: bool);
+    /// True for the neutral element.
+    fn is_identity(&self, o: Self::Offset) -> bool {
+        o == Self::Offset::default()
+    }
+    /// A dummy point set whose Delaunay triangulation satisfies the switch criterion.
+    fn dummy_points(&self) -> Vec<Self::Point>;
+    /// Number of sheets of the initial covering (`covering_copies().len()`).
+    fn sheets(&self) -> usize;
+    /// Index of the sheet holding a lifted copy with offset `o` (in `0..sheets()`).
+    fn sheet_of(&self, o: Self::Offset) -> usize;
+    /// Appends to `out` every lifted copy `(i, o)` of `pts[i]` whose position is within
+    /// `radius` of the lifted point `z` (generous: a copy slightly farther may be included).
+    fn near(
+        &self,
+        z: Lifted<Self::Point, Self::Offset>,
+        pts: &[Self::Point],
+        radius: f64,
+        out: &mut Vec<(u32, Self::Offset)>,
+    );
+    /// An upper bound on the length of a Delaunay edge: in the initial covering (for any
+    /// non-empty point set) when `one_sheeted` is false, and under the switch criterion when
+    /// it is true.
+    fn edge_bound(&self, one_sheeted: bool) -> f64;
+    /// A key along a space-filling curve, for spatial sorting.
+    fn spatial_key(&self, p: &Self::Point) -> u64;
+    /// Signed volume of a lifted cell (approximate).
+    fn volume(&self, s: &[Lifted<Self::Point, Self::Offset>; N]) -> f64;
+    /// Volume of the fundamental domain.
+    fn domain_volume(&self) -> f64;
+}

@@ -1,0 +1,159 @@
+//! The combinatorial simplicial complex: cells of `N` vertices with their `N` neighbours
+//! (neighbour `i` is opposite vertex `i`) and one group element per vertex, `u32` ids, a free
+//! list, and generation stamps for visits.
+
+/// Marks a missing id.
+pub const NONE: u32 = u32::MAX;
+
+/// A cell: vertex ids, neighbour ids, and the offset of each vertex.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Cell<O, const N: usize> {
+    pub v: [u32; N],
+    pub n: [u32; N],
+    pub off: [O; N],
+}
+
+impl<O: Copy + Default, const N: usize> Cell<O, N> {
+    /// A cell with no neighbours yet.
+    pub fn new(v: [u32; N], off: [O; N]) -> Self {
+        Cell {
+            v,
+            n: [NONE; N],
+            off,
+        }
+    }
+
+    /// Index of vertex `x` in this cell.
+    #[inline]
+    pub fn index_of(&self, x: u32) -> Option<usize> {
+        self.v.iter().position(|&v| v == x)
+    }
+
+    /// Index of neighbour `c` in this cell.
+    #[inline]
+    pub fn mirror(&self, c: u32) -> Option<usize> {
+        self.n.iter().position(|&n| n == c)
+    }
+}
+
+/// Cell storage with a free list and visit stamps.
+#[derive(Clone, Debug, Default)]
+pub struct Tds<O, const N: usize> {
+    pub cells: Vec<Cell<O, N>>,
+    free: Vec<u32>,
+    stamp: Vec<u32>,
+    generation: u32,
+}
+
+impl<O: Copy + Default, const N: usize> Tds<O, N> {
+    /// An empty complex.
+    pub fn new() -> Self {
+        Tds {
+            cells: Vec::new(),
+            free: Vec::new(),
+            stamp: Vec::new(),
+            generation: 0,
+        }
+    }
+
+    /// Adds a cell, reusing a free slot when there is one.
+    #[inline]
+    pub fn create(&mut self, c: Cell<O, N>) -> u32 {
+        if let Some(id) = self.free.pop() {
+            self.cells[id as usize] = c;
+            id
+        } else {
+            self.cells.push(c);
+            self.stamp.push(0);
+            (self.cells.len() - 1) as u32
+        }
+    }
+
+    /// Removes a cell (its slot goes to the free list).
+    #[inline]
+    pub fn delete(&mut self, id: u32) {
+        self.cells[id as usize].v[0] = NONE;
+        self.free.push(id);
+    }
+
+    /// True if the slot holds a live cell.
+    #[inline]
+    pub fn is_alive(&self, id: u32) -> bool {
+        self.cells[id as usize].v[0] != NONE
+    }
+
+    /// Number of live cells.
+    pub fn len(&self) -> usize {
+        self.cells.len() - self.free.len()
+    }
+
+    /// True when there is no live cell.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Ids of the live cells.
+    pub fn ids(&self) -> impl Iterator<Item = u32> + '_ {
+        (0..self.cells.len() as u32).filter(|&i| self.is_alive(i))
+    }
+
+    /// Starts a new visit and returns two fresh stamp values (for "in" and "out").
+    #[inline]
+    pub fn new_visit(&mut self) -> (u32, u32) {
+        if self.generation >= u32::MAX - 4 {
+            self.stamp.iter_mut().for_each(|s| *s = 0);
+            self.generation = 0;
+        }
+        self.generation += 2;
+        (self.generation - 1, self.generation)
+    }
+
+    /// The stamp of a cell.
+    #[inline]
+    pub fn stamp(&self, id: u32) -> u32 {
+        self.stamp[id as usize]
+    }
+
+    /// Sets the stamp of a cell.
+    #[inline]
+    pub fn set_stamp(&mut self, id: u32, s: u32) {
+        self.stamp[id as usize] = s;
+    }
+
+    /// Drops every cell.
+    pub fn clear(&mut self) {
+        self.cells.clear();
+        self.free.clear();
+        self.stamp.clear();
+    }
+
+    /// Reserves room for `n` more cells.
+    pub fn reserve(&mut self, n: usize) {
+        self.cells.reserve(n);
+        self.stamp.reserve(n);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn create_delete_reuse() {
+        let mut t: Tds<u8, 3> = Tds::new();
+        let a = t.create(Cell::new([0, 1, 2], [0; 3]));
+        let b = t.create(Cell::new([1, 2, 3], [0; 3]));
+        assert_eq!(t.len(), 2);
+        t.delete(a);
+        assert!(!t.is_alive(a) && t.is_alive(b));
+        assert_eq!(t.ids().collect::<Vec<_>>(), vec![b]);
+        let c = t.create(Cell::new([4, 5, 6], [0; 3]));
+        assert_eq!(c, a);
+        assert_eq!(t.cells[c as usize].index_of(5), Some(1));
+        let (i, o) = t.new_visit();
+        assert_ne!(i, o);
+        t.set_stamp(b, i);
+        assert_eq!(t.stamp(b), i);
+        assert_eq!(t.cells[b as usize].mirror(NONE), Some(0));
+    }
+}
