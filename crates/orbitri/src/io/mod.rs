@@ -1,1 +1,26 @@
-//! Readers and writers.
+//! Readers (points from text or `.npy`) and writers (the `cells` format and JSON).
+
+mod npy;
+mod text;
+mod write;
+
+pub use npy::{encode_npy, read_npy};
+pub use text::{parse_text, read_text};
+pub use write::{write_cells, write_json};
+
+use std::path::Path;
+
+use crate::error::Result;
+
+/// Reads `dim`-dimensional points from a text file or, for a `.npy` name, a float64 array
+/// of shape `(N, dim)`.
+pub fn read_points(path: &Path, dim: usize) -> Result<Vec<Vec<f64>>> {
+    if path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("npy"))
+    {
+        read_npy(path, dim)
+    } else {
+        read_text(path, dim)
+    }
+}

@@ -1,0 +1,114 @@
+//! Text points: one point per line, coordinates separated by blanks or commas, `#` starts a
+//! comment, blank lines are skipped.
+
+use std::path::{Path, PathBuf};
+
+use crate::error::{Error, Result};
+
+/// Reads a text point file.
+pub fn read_text(path: &Path, dim: usize) -> Result<Vec<Vec<f64>>> {
+    let bytes = std::fs::read(path).map_err(|source| Error::Io {
+        file: path.to_path_buf(),
+        source,
+    })?;
+    let text = String::from_utf8(bytes).map_err(|e| Error::Parse {
+        file: path.to_path_buf(),
+        line: 1 + e.as_bytes()[..e.utf8_error().valid_up_to()]
+            .iter()
+            .filter(|&&b| b == b'\n')
+            .count(),
+        message: "not UTF-8 text (for binary input use a .npy file)".into(),
+    })?;
+    parse_text(&text, path, dim)
+}
+
+/// Parses text points; `file` is only used in error messages.
+pub fn parse_text(text: &str, file: &Path, dim: usize) -> Result<Vec<Vec<f64>>> {
+    let err = |line: usize, message: String| Error::Parse {
+        file: PathBuf::from(file),
+        line,
+        message,
+    };
+    let mut out = Vec::new();
+    for (k, raw) in text.lines().enumerate() {
+        let line = k + 1;
+        let body = raw.split('#').next().unwrap_or("");
+        let fields: Vec<&str> = body
+            .split(|c: char| c == ',' || c.is_whitespace())
+            .filter(|s| !s.is_empty())
+            .collect();
+        if fields.is_empty() {
+            continue;
+        }
+        if fields.len() != dim {
+            return Err(err(
+                line,
+                format!(
+                    "expected {dim} coordinates, found {} ({:?})",
+                    fields.len(),
+                    body.trim()
+                ),
+            ));
+        }
+        let mut p = Vec::with_capacity(dim);
+        for (axis, f) in fields.iter().enumerate() {
+            let v: f64 = f
+                .parse()
+                .map_err(|_| err(line, format!("coordinate {axis} '{f}' is not a number")))?;
+            if !v.is_finite() {
+                return Err(err(
+                    line,
+                    format!("coordinate {axis} is {v}, not a finite number"),
+                ));
+            }
+            p.push(v);
+        }
+        out.push(p);
+    }
+    if out.is_empty() {
+        return Err(err(
+            text.lines().count().max(1),
+            "the file holds no points".into(),
+        ));
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(s: &str) -> Result<Vec<Vec<f64>>> {
+        parse_text(s, Path::new("in.txt"), 3)
+    }
+
+    #[test]
+    fn comments_commas_blanks() {
+        let p = parse("# header\n0.1 0.2 0.3\n\n0.4,0.5, 0.6  # trailing\n1e-3\t2 3\n").unwrap();
+        assert_eq!(
+            p,
+            vec![
+                vec![0.1, 0.2, 0.3],
+                vec![0.4, 0.5, 0.6],
+                vec![1e-3, 2.0, 3.0]
+            ]
+        );
+    }
+
+    #[test]
+    fn errors_name_file_line_and_value() {
+        let e = parse("0 0 0\n0.1 nan 0.3\n").unwrap_err().to_string();
+        assert_eq!(e, "in.txt:2: coordinate 1 is NaN, not a finite number");
+        let e = parse("0 0 0\n1 2\n").unwrap_err().to_string();
+        assert!(
+            e.starts_with("in.txt:2: expected 3 coordinates, found 2"),
+            "{e}"
+        );
+        let e = parse("0 0 x1\n").unwrap_err().to_string();
+        assert_eq!(e, "in.txt:1: coordinate 2 'x1' is not a number");
+        let e = parse("1 2 inf\n").unwrap_err().to_string();
+        assert_eq!(e, "in.txt:1: coordinate 2 is inf, not a finite number");
+        let e = parse("# only a comment\n").unwrap_err().to_string();
+        assert_eq!(e, "in.txt:1: the file holds no points");
+    }
+}

@@ -1,0 +1,222 @@
+//! Independent checks: nothing here calls the predicates or the engine's geometry.
+#![allow(dead_code)]
+
+use std::collections::HashMap;
+
+use orbitri::sort::SplitMix;
+use orbitri::{CellView, Copies, PeriodicDelaunay3};
+
+pub fn uniform(n: usize, seed: u64, scale: [f64; 3]) -> Vec<[f64; 3]> {
+    let mut r = SplitMix::new(seed);
+    (0..n)
+        .map(|_| {
+            [
+                r.unit() * scale[0],
+                r.unit() * scale[1],
+                r.unit() * scale[2],
+            ]
+        })
+        .collect()
+}
+
+fn lift(p: &[f64; 3], o: &[i8; 3], m: &[[f64; 3]; 3]) -> [f64; 3] {
+    std::array::from_fn(|c| p[c] + (0..3).map(|k| o[k] as f64 * m[k][c]).sum::<f64>())
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn det(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
+    a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+        + a[2] * (b[0] * c[1] - b[1] * c[0])
+}
+
+/// Circumcenter by Cramer's rule on `2 (p_i − p_0)·x = |p_i|² − |p_0|²`.
+fn circumcenter(p: &[[f64; 3]; 4]) -> [f64; 3] {
+    let d: Vec<[f64; 3]> = (1..4).map(|i| sub(p[i], p[0])).collect();
+    let rhs: Vec<f64> = d
+        .iter()
+        .map(|v| 0.5 * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]))
+        .collect();
+    let den = det(d[0], d[1], d[2]);
+    let mut x = [0.0; 3];
+    for k in 0..3 {
+        let rows: Vec<[f64; 3]> = (0..3)
+            .map(|i| {
+                let mut r = d[i];
+                r[k] = rhs[i];
+                r
+            })
+            .collect();
+        x[k] = det(rows[0], rows[1], rows[2]) / den;
+    }
+    [x[0] + p[0][0], x[1] + p[0][1], x[2] + p[0][2]]
+}
+
+fn invert(m: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
+    let d = det(m[0], m[1], m[2]);
+    let c = |a: [f64; 3], b: [f64; 3]| {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    };
+    // rows of M⁻¹ as columns of the cofactor matrix: x·M⁻¹ = fractional coordinates
+    let cols = [c(m[1], m[2]), c(m[2], m[0]), c(m[0], m[1])];
+    std::array::from_fn(|i| std::array::from_fn(|j| cols[j][i] / d))
+}
+
+/// Brute-force verification of a periodic Delaunay triangulation:
+/// positive volumes summing to sheets × domain volume; every facet shared by exactly two
+/// cells (per copy); and every circumsphere empty of all periodic copies of all points
+/// (points on the sphere allowed, relative tolerance 1e-9).
+pub fn brute_force_check(tri: &PeriodicDelaunay3, input: &[[f64; 3]]) {
+    let m = tri.space().lattice().vectors();
+    let inv = invert(&m);
+    let vol_dom = det(m[0], m[1], m[2]).abs();
+    let sheets = tri.sheets() as f64;
+    let cells = tri.cells(Copies::Stored);
+    let pts: Vec<[f64; 3]> = (0..input.len())
+        .map(|i| tri.points()[tri.vertex_of_input(i) as usize])
+        .collect();
+    let mut total = 0.0;
+    for c in &cells {
+        let p: [[f64; 3]; 4] =
+            std::array::from_fn(|i| lift(&pts[c.vertices[i] as usize], &c.offsets[i], &m));
+        let v = det(sub(p[1], p[0]), sub(p[2], p[0]), sub(p[3], p[0])) / 6.0;
+        assert!(v > 0.0, "cell {c:?} has volume {v}");
+        total += v;
+    }
+    assert!(
+        (total - sheets * vol_dom).abs() <= 1e-9 * sheets * vol_dom,
+        "volumes sum to {total}, expected {}",
+        sheets * vol_dom
+    );
+    let mut facets: HashMap<Vec<(u32, [i8; 3])>, usize> = HashMap::new();
+    for c in &cells {
+        for skip in 0..4 {
+            let mut f: Vec<(u32, [i8; 3])> = (0..4)
+                .filter(|&i| i != skip)
+                .map(|i| (c.vertices[i], c.offsets[i]))
+                .collect();
+            for k in 0..3 {
+                let mn = f.iter().map(|x| x.1[k]).min().unwrap();
+                f.iter_mut().for_each(|x| x.1[k] -= mn);
+            }
+            f.sort_unstable();
+            *facets.entry(f).or_default() += 1;
+        }
+    }
+    let per = 2 * tri.sheets();
+    for (f, n) in &facets {
+        assert_eq!(*n, per, "facet {f:?} appears {n} times, expected {per}");
+    }
+    // distinct input points (first occurrences) only
+    let firsts: Vec<usize> = {
+        let fo = tri.first_occurrences();
+        (0..input.len()).filter(|&i| fo[i] as usize == i).collect()
+    };
+    for c in &cells {
+        let p: [[f64; 3]; 4] =
+            std::array::from_fn(|i| lift(&pts[c.vertices[i] as usize], &c.offsets[i], &m));
+        let z = circumcenter(&p);
+        let r2 = (0..3).map(|k| (p[0][k] - z[k]).powi(2)).sum::<f64>();
+        let r = r2.sqrt();
+        let fz: [f64; 3] = std::array::from_fn(|j| (0..3).map(|k| z[k] * inv[k][j]).sum());
+        let span: [f64; 3] =
+            std::array::from_fn(|j| r * (0..3).map(|k| inv[k][j] * inv[k][j]).sum::<f64>().sqrt());
+        for &i in &firsts {
+            let q = pts[i];
+            let fq: [f64; 3] = std::array::from_fn(|j| (0..3).map(|k| q[k] * inv[k][j]).sum());
+            let lo: [i32; 3] =
+                std::array::from_fn(|j| (fz[j] - fq[j] - span[j]).floor() as i32 - 1);
+            let hi: [i32; 3] = std::array::from_fn(|j| (fz[j] - fq[j] + span[j]).ceil() as i32 + 1);
+            for x in lo[0]..=hi[0] {
+                for y in lo[1]..=hi[1] {
+                    for w in lo[2]..=hi[2] {
+                        let o = [x as i8, y as i8, w as i8];
+                        if (0..4).any(|k| c.vertices[k] as usize == i && c.offsets[k] == o) {
+                            continue;
+                        }
+                        let l = lift(&q, &o, &m);
+                        let d2 = (0..3).map(|k| (l[k] - z[k]).powi(2)).sum::<f64>();
+                        assert!(d2 >= r2 * (1.0 - 1e-9), "point {i} at offset {o:?} is inside the circumsphere of {c:?}: {d2} < {r2}");
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Canonical cell set as in the CGAL oracle dumps: (id, offset) pairs sorted by id, offsets
+/// translated so that their componentwise minimum is 0, lines sorted.
+pub fn canonical_cells(cells: &[CellView]) -> Vec<[i64; 16]> {
+    let mut out: Vec<[i64; 16]> = cells
+        .iter()
+        .map(|c| {
+            let mut pairs: Vec<(u32, [i8; 3])> =
+                (0..4).map(|i| (c.vertices[i], c.offsets[i])).collect();
+            pairs.sort_unstable();
+            for k in 0..3 {
+                let mn = pairs.iter().map(|x| x.1[k]).min().unwrap();
+                pairs.iter_mut().for_each(|x| x.1[k] -= mn);
+            }
+            let mut line = [0i64; 16];
+            for (i, (v, o)) in pairs.iter().enumerate() {
+                line[i] = *v as i64;
+                for k in 0..3 {
+                    line[4 + 3 * i + k] = o[k] as i64;
+                }
+            }
+            line
+        })
+        .collect();
+    out.sort_unstable();
+    out
+}
+
+pub fn data_dir() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data")
+}
+
+/// Reads an oracle input: first line the periods, then points.
+pub fn read_oracle_input(name: &str) -> ([f64; 3], Vec<[f64; 3]>) {
+    let text = std::fs::read_to_string(data_dir().join(format!("{name}.txt"))).unwrap();
+    let mut lines = text.lines();
+    let per: Vec<f64> = lines
+        .next()
+        .unwrap()
+        .split_whitespace()
+        .map(|s| s.parse().unwrap())
+        .collect();
+    let pts = lines
+        .filter(|l| !l.trim().is_empty())
+        .map(|l| {
+            let v: Vec<f64> = l.split_whitespace().map(|s| s.parse().unwrap()).collect();
+            [v[0], v[1], v[2]]
+        })
+        .collect();
+    ([per[0], per[1], per[2]], pts)
+}
+
+/// Reads an oracle dump: header and canonical lines.
+pub fn read_dump(name: &str) -> ((usize, usize, usize), Vec<[i64; 16]>) {
+    let text = std::fs::read_to_string(data_dir().join(format!("{name}.dump3"))).unwrap();
+    let mut lines = text.lines();
+    let h: Vec<usize> = lines
+        .next()
+        .unwrap()
+        .split_whitespace()
+        .map(|s| s.parse().unwrap())
+        .collect();
+    let cells = lines
+        .filter(|l| !l.trim().is_empty())
+        .map(|l| {
+            let v: Vec<i64> = l.split_whitespace().map(|s| s.parse().unwrap()).collect();
+            std::array::from_fn(|i| v[i])
+        })
+        .collect();
+    ((h[0], h[1], h[2]), cells)
+}
