@@ -170,10 +170,7 @@ impl PeriodicDelaunay3 {
                     self.point_input.push(i);
                 }
                 Inserted::Duplicate(p) if p < k => return false,
-                Inserted::Duplicate(p) => {
-                    self.input_point[i as usize] = p;
-                    self.duplicates += 1;
-                }
+                Inserted::Duplicate(p) => self.record_duplicate(i as usize, p),
             }
             if n % 4096 == 0 {
                 progress(n);
@@ -200,12 +197,17 @@ impl PeriodicDelaunay3 {
                 self.input_point[i] = v;
                 self.point_input.push(i as u32);
             }
-            Inserted::Duplicate(v) => {
-                self.input_point[i] = v;
-                self.duplicates += 1;
-            }
+            Inserted::Duplicate(v) => self.record_duplicate(i, v),
         }
         r
+    }
+
+    /// Input `i` coincides with point `p`; the point keeps the smallest input id.
+    fn record_duplicate(&mut self, i: usize, p: u32) {
+        self.input_point[i] = p;
+        self.duplicates += 1;
+        let first = &mut self.point_input[p as usize];
+        *first = (*first).min(i as u32);
     }
 
     /// Inserts one more point (wrapped into the domain); its input id is the number of

@@ -9,6 +9,9 @@ use crate::predicates::filter::Rows;
 /// shortest lattice vector are bounded by the defect, so enumerating `|x_i| ≤ 4` finds it.
 pub const MAX_DEFECT: f64 = 4.0;
 const ENUM: i32 = 4;
+/// Largest number of copies per lattice vector in the initial covering (offsets are stored in
+/// 8 bits and stay below twice this).
+pub const MAX_COPIES: i32 = 40;
 
 /// A lattice given by `D` linearly independent row vectors; the domain is
 /// `{ f·M : f ∈ [0,1)^D }`.
@@ -181,36 +184,24 @@ impl<const D: usize> Lattice<D> {
     /// diameter a single point can leave, `√(Σ|b_i|²)` (covering radius ≤ ½√(Σ|b_i*|²));
     /// Corollary 9 of Caroli–Teillaud then makes the covering a triangulation for any point
     /// set (Lemma 2.3.8 of the thesis for cuboids). A cube uses 3 per axis (Theorem 2.2.8).
+    /// At most [`MAX_COPIES`] per axis: more elongated boxes are rejected at construction.
     pub fn covering(&self) -> [i32; D] {
         let l0 = self.rows.m[0][0];
         if self.rows.diagonal && (0..D).all(|i| self.rows.m[i][i] == l0) {
             return [3; D];
         }
-        let big = 2.0 * self.rows.m.iter().map(|r| dot(r, r)).sum::<f64>().sqrt();
-        let mut best: Option<([i32; D], i64)> = None;
-        let mut h = [1i32; D];
-        loop {
-            let sheets: i64 = h.iter().map(|&v| v as i64).product();
-            if best.map_or(true, |(_, s)| sheets < s)
-                && shortest_vector(&self.rows, h) > big * (1.0 + 1e-9)
-            {
-                best = Some((h, sheets));
-            }
-            let mut i = 0;
-            while i < D {
-                h[i] += 1;
-                if h[i] <= 8 {
-                    break;
-                }
-                h[i] = 1;
-                i += 1;
-            }
-            if i == D {
-                break;
-            }
+        let big = 2.0 * self.rows.m.iter().map(|r| dot(r, r)).sum::<f64>().sqrt() * (1.0 + 1e-9);
+        // start below the answer and grow the copies along the currently shortest vector
+        let mut h: [i32; D] = std::array::from_fn(|i| ((big / norm(&self.rows.m[i])).floor() as i32).max(1));
+        while shortest_vector(&self.rows, h) <= big {
+            let i = (0..D).min_by(|&a, &b| {
+                let la = h[a] as f64 * norm(&self.rows.m[a]);
+                let lb = h[b] as f64 * norm(&self.rows.m[b]);
+                la.total_cmp(&lb)
+            });
+            h[i.unwrap()] += 1;
         }
-        best.expect("a covering with at most 8 copies per axis exists for defect ≤ 4")
-            .0
+        h
     }
 
     /// A jittered grid of `Π k_i` dummy points in fractional coordinates whose largest empty
