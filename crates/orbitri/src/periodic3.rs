@@ -163,6 +163,8 @@ impl PeriodicDelaunay3 {
         self.engine.points = dummies;
         self.engine.bootstrap_one_sheeted();
         self.input_point = vec![NONE; pts.len()];
+        // placeholders: point indices count the dummies until they are dropped
+        self.point_input = vec![NONE; k as usize];
         for (n, &i) in order.iter().enumerate() {
             match self.engine.insert(pts[i as usize]) {
                 Inserted::New(p) => {
@@ -182,6 +184,7 @@ impl PeriodicDelaunay3 {
             }
         }
         self.engine.drop_leading_points(k);
+        self.point_input.drain(..k as usize);
         for p in self.input_point.iter_mut() {
             *p -= k;
         }

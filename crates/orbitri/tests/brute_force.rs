@@ -21,7 +21,11 @@ fn triclinic() -> FlatTorus3 {
 fn tiny_sets_stay_in_the_covering_and_are_correct() {
     for n in 1..=10 {
         let pts = uniform(n, n as u64, [1.0; 3]);
-        let tri = build(FlatTorus3::cuboid([1.0; 3]).unwrap(), &pts, BuildOptions::default());
+        let tri = build(
+            FlatTorus3::cuboid([1.0; 3]).unwrap(),
+            &pts,
+            BuildOptions::default(),
+        );
         assert_eq!(tri.number_of_vertices(), n);
         if n <= 5 {
             assert_eq!(tri.sheets(), 27, "{n} points cannot triangulate the torus");
@@ -31,15 +35,24 @@ fn tiny_sets_stay_in_the_covering_and_are_correct() {
         let e = tri.edges(Copies::Stored).len();
         let f = tri.facets(Copies::Stored).len();
         let v = tri.number_of_vertices() * tri.sheets();
-        assert_eq!(v as i64 - e as i64 + f as i64 - tri.number_of_cells() as i64, 0);
+        assert_eq!(
+            v as i64 - e as i64 + f as i64 - tri.number_of_cells() as i64,
+            0
+        );
     }
 }
 
 #[test]
 fn cuboids_and_triclinic_cells() {
     for (space, scale) in [
-        (FlatTorus3::cuboid([1.0, 2.0, 0.5]).unwrap(), [1.0, 2.0, 0.5]),
-        (FlatTorus3::cuboid([3.0, 3.0, 3.0]).unwrap(), [3.0, 3.0, 3.0]),
+        (
+            FlatTorus3::cuboid([1.0, 2.0, 0.5]).unwrap(),
+            [1.0, 2.0, 0.5],
+        ),
+        (
+            FlatTorus3::cuboid([3.0, 3.0, 3.0]).unwrap(),
+            [3.0, 3.0, 3.0],
+        ),
         (triclinic(), [1.5, 1.5, 1.5]),
     ] {
         for n in [7, 60, 1500] {
@@ -61,7 +74,9 @@ fn insertion_order_does_not_matter() {
         (triclinic(), 500, [1.0; 3]),
     ] {
         let pts = uniform(n, 5, scale);
-        let reference = canonical_cells(&build(space.clone(), &pts, BuildOptions::default()).cells(Copies::Unique));
+        let reference = canonical_cells(
+            &build(space.clone(), &pts, BuildOptions::default()).cells(Copies::Unique),
+        );
         let mut rng = SplitMix::new(99);
         for trial in 0..3 {
             let mut perm: Vec<usize> = (0..n).collect();
@@ -69,8 +84,14 @@ fn insertion_order_does_not_matter() {
                 perm.swap(i, rng.below(i + 1));
             }
             let shuffled: Vec<[f64; 3]> = perm.iter().map(|&i| pts[i]).collect();
-            let opts = BuildOptions { seed: trial, spatial_sort: trial != 1, dummy_threshold: if trial == 2 { usize::MAX } else { 1000 } };
-            let tri = build(space.clone(), &shuffled, opts);
+            let opts = BuildOptions {
+                seed: trial,
+                spatial_sort: trial != 1,
+                dummy_threshold: if trial == 2 { usize::MAX } else { 1000 },
+            };
+            let tri =
+                PeriodicDelaunay3::build_with(space.clone(), &shuffled, opts, |_| {}).unwrap();
+            tri.is_valid().unwrap();
             let mapped: Vec<orbitri::CellView> = tri
                 .cells(Copies::Unique)
                 .into_iter()
@@ -90,7 +111,11 @@ fn crystal(cells: usize, basis: &[[f64; 3]], a: f64) -> Vec<[f64; 3]> {
         for j in 0..cells {
             for k in 0..cells {
                 for b in basis {
-                    out.push([(i as f64 + b[0]) * a, (j as f64 + b[1]) * a, (k as f64 + b[2]) * a]);
+                    out.push([
+                        (i as f64 + b[0]) * a,
+                        (j as f64 + b[1]) * a,
+                        (k as f64 + b[2]) * a,
+                    ]);
                 }
             }
         }
@@ -102,14 +127,35 @@ fn crystal(cells: usize, basis: &[[f64; 3]], a: f64) -> Vec<[f64; 3]> {
 fn crystal_lattices_with_inexact_coordinates() {
     // lattice constant 0.1 is not a binary fraction: every cospherical test is exact work
     let sc = crystal(6, &[[0.0; 3]], 0.1);
-    let tri = build(FlatTorus3::cuboid([0.6; 3]).unwrap(), &sc, BuildOptions::default());
+    let tri = build(
+        FlatTorus3::cuboid([0.6; 3]).unwrap(),
+        &sc,
+        BuildOptions::default(),
+    );
     assert_eq!(tri.number_of_cells(), 6 * 216);
-    let fcc = crystal(4, &[[0.0, 0.0, 0.0], [0.5, 0.5, 0.0], [0.5, 0.0, 0.5], [0.0, 0.5, 0.5]], 0.3);
-    let tri = build(FlatTorus3::cuboid([1.2; 3]).unwrap(), &fcc, BuildOptions::default());
+    let fcc = crystal(
+        4,
+        &[
+            [0.0, 0.0, 0.0],
+            [0.5, 0.5, 0.0],
+            [0.5, 0.0, 0.5],
+            [0.0, 0.5, 0.5],
+        ],
+        0.3,
+    );
+    let tri = build(
+        FlatTorus3::cuboid([1.2; 3]).unwrap(),
+        &fcc,
+        BuildOptions::default(),
+    );
     // each FCC point: 8 tetrahedral holes/4 + 4 octahedral holes ... 2 tets + 1 octahedron (4 cells) per point
     assert_eq!(tri.number_of_cells(), 6 * fcc.len());
     let bcc = crystal(5, &[[0.0; 3], [0.5; 3]], 0.2);
-    let tri = build(FlatTorus3::cuboid([1.0; 3]).unwrap(), &bcc, BuildOptions::default());
+    let tri = build(
+        FlatTorus3::cuboid([1.0; 3]).unwrap(),
+        &bcc,
+        BuildOptions::default(),
+    );
     assert_eq!(tri.number_of_cells(), 6 * bcc.len());
 }
 
@@ -123,7 +169,9 @@ fn fcc_in_its_primitive_triclinic_cell_tiled() {
     for i in 0..4 {
         for j in 0..4 {
             for l in 0..4 {
-                pts.push(std::array::from_fn(|c| i as f64 * a[0][c] + j as f64 * a[1][c] + l as f64 * a[2][c]));
+                pts.push(std::array::from_fn(|c| {
+                    i as f64 * a[0][c] + j as f64 * a[1][c] + l as f64 * a[2][c]
+                }));
             }
         }
     }
@@ -141,7 +189,11 @@ fn duplicates_and_wrapping_lose_nothing() {
     pts.push([1.375, -1.375, 3.125]);
     pts.push([1.0, 0.5, 0.5]); // on the upper face (CGAL issue #7479)
     pts.push([-1e-20, 0.25, 1.0]);
-    let tri = build(FlatTorus3::cuboid([1.0; 3]).unwrap(), &pts, BuildOptions::default());
+    let tri = build(
+        FlatTorus3::cuboid([1.0; 3]).unwrap(),
+        &pts,
+        BuildOptions::default(),
+    );
     assert_eq!(tri.duplicates(), 2);
     assert_eq!(tri.number_of_vertices(), 502);
     assert_eq!(tri.wrapped(), 3);
@@ -149,8 +201,14 @@ fn duplicates_and_wrapping_lose_nothing() {
     assert_eq!(first[500], 10);
     assert_eq!(first[501], 20);
     assert_eq!(first[502], 502);
-    assert_eq!(tri.points()[tri.vertex_of_input(502) as usize], [0.0, 0.5, 0.5]);
-    assert_eq!(tri.points()[tri.vertex_of_input(503) as usize], [0.0, 0.25, 0.0]);
+    assert_eq!(
+        tri.points()[tri.vertex_of_input(502) as usize],
+        [0.0, 0.5, 0.5]
+    );
+    assert_eq!(
+        tri.points()[tri.vertex_of_input(503) as usize],
+        [0.0, 0.25, 0.0]
+    );
     for i in 0..pts.len() {
         assert_eq!(tri.input_of_vertex(tri.vertex_of_input(i)), first[i]);
     }
@@ -168,11 +226,22 @@ fn incremental_insertion_matches_bulk() {
     }
     assert_eq!(inc.insert(pts[3]).unwrap(), Inserted::Duplicate(3));
     inc.is_valid().unwrap();
-    let bulk = build(FlatTorus3::cuboid([1.0; 3]).unwrap(), &pts, BuildOptions::default());
-    assert_eq!(canonical_cells(&inc.cells(Copies::Unique)), canonical_cells(&bulk.cells(Copies::Unique)));
+    let bulk = build(
+        FlatTorus3::cuboid([1.0; 3]).unwrap(),
+        &pts,
+        BuildOptions::default(),
+    );
+    assert_eq!(
+        canonical_cells(&inc.cells(Copies::Unique)),
+        canonical_cells(&bulk.cells(Copies::Unique))
+    );
     // inserting into a forced 1-sheeted triangulation (criterion not guaranteed) stays correct
     let few = uniform(120, 4, [1.0; 3]);
-    let mut t = build(FlatTorus3::cuboid([1.0; 3]).unwrap(), &few, BuildOptions::default());
+    let mut t = build(
+        FlatTorus3::cuboid([1.0; 3]).unwrap(),
+        &few,
+        BuildOptions::default(),
+    );
     let extra = uniform(30, 77, [1.0; 3]);
     for p in &extra {
         t.insert(*p).unwrap();
@@ -186,8 +255,12 @@ fn incremental_insertion_matches_bulk() {
 fn clustered_points_fall_back_from_dummies() {
     // all points in a small ball: the dummy start cannot be kept, the covering takes over
     let mut pts = uniform(300, 21, [0.1; 3]);
-    pts.iter_mut().for_each(|p| p.iter_mut().for_each(|x| *x += 0.45));
-    let opts = BuildOptions { dummy_threshold: 200, ..Default::default() };
+    pts.iter_mut()
+        .for_each(|p| p.iter_mut().for_each(|x| *x += 0.45));
+    let opts = BuildOptions {
+        dummy_threshold: 200,
+        ..Default::default()
+    };
     let tri = build(FlatTorus3::cuboid([1.0; 3]).unwrap(), &pts, opts);
     assert!(!tri.used_dummy_points());
     assert_eq!(tri.sheets(), 27);
@@ -196,7 +269,11 @@ fn clustered_points_fall_back_from_dummies() {
 #[test]
 fn access_api() {
     let pts = uniform(400, 2, [1.0; 3]);
-    let mut tri = build(FlatTorus3::cuboid([1.0; 3]).unwrap(), &pts, BuildOptions::default());
+    let mut tri = build(
+        FlatTorus3::cuboid([1.0; 3]).unwrap(),
+        &pts,
+        BuildOptions::default(),
+    );
     let cells = tri.cells(Copies::Unique);
     let edges = tri.edges(Copies::Unique);
     let facets = tri.facets(Copies::Unique);
@@ -206,26 +283,45 @@ fn access_api() {
     assert_eq!(degree_sum, 2 * edges.len());
     for n in tri.vertex_neighbors(0) {
         let d = [0, 1, 2].map(|c| pts[n.0 as usize][c] + n.1[c] as f64 - pts[0][c]);
-        assert!(d.iter().map(|x| x * x).sum::<f64>() < 0.5, "neighbour far away: {n:?}");
+        assert!(
+            d.iter().map(|x| x * x).sum::<f64>() < 0.5,
+            "neighbour far away: {n:?}"
+        );
     }
     // locate: the point is inside (or on) the returned cell
-    for q in uniform(50, 123, [1.0; 3]).iter().chain([[1.5, -0.2, 0.7]].iter()) {
+    for q in uniform(50, 123, [1.0; 3])
+        .iter()
+        .chain([[1.5, -0.2, 0.7]].iter())
+    {
         let (cell, o) = tri.locate(*q).unwrap();
         let wq = tri.space().lattice().wrap(*q).0;
-        let corner = |i: usize| [0, 1, 2].map(|c| tri.points()[tri.vertex_of_input(cell.vertices[i] as usize) as usize][c] + cell.offsets[i][c] as f64);
+        let corner = |i: usize| {
+            [0, 1, 2].map(|c| {
+                tri.points()[tri.vertex_of_input(cell.vertices[i] as usize) as usize][c]
+                    + cell.offsets[i][c] as f64
+            })
+        };
         let qq = [0, 1, 2].map(|c| wq[c] + o[c] as f64);
         for i in 0..4 {
             let mut s = [corner(0), corner(1), corner(2), corner(3)];
             s[i] = qq;
             let d = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
             let (a, b, c) = (d(s[1], s[0]), d(s[2], s[0]), d(s[3], s[0]));
-            let det = a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) + a[2] * (b[0] * c[1] - b[1] * c[0]);
+            let det = a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+                + a[2] * (b[0] * c[1] - b[1] * c[0]);
             assert!(det >= -1e-12, "query outside the located cell");
         }
     }
     // STORED in the covering: every copy
-    let small = build(FlatTorus3::cuboid([1.0; 3]).unwrap(), &pts[..3], BuildOptions::default());
-    assert_eq!(small.cells(Copies::Stored).len(), 27 * small.cells(Copies::Unique).len());
+    let small = build(
+        FlatTorus3::cuboid([1.0; 3]).unwrap(),
+        &pts[..3],
+        BuildOptions::default(),
+    );
+    assert_eq!(
+        small.cells(Copies::Stored).len(),
+        27 * small.cells(Copies::Unique).len()
+    );
 }
 
 #[test]
@@ -233,8 +329,12 @@ fn bad_input_is_rejected_with_the_place() {
     let torus = FlatTorus3::cuboid([1.0; 3]).unwrap();
     let e = PeriodicDelaunay3::build(torus.clone(), &[]).unwrap_err();
     assert_eq!(e.to_string(), "the input holds no points");
-    let e = PeriodicDelaunay3::build(torus.clone(), &[[0.1, 0.2, 0.3], [0.0, f64::INFINITY, 0.0]]).unwrap_err();
-    assert_eq!(e.to_string(), "point 1: coordinate 1 is inf, not a finite number");
+    let e = PeriodicDelaunay3::build(torus.clone(), &[[0.1, 0.2, 0.3], [0.0, f64::INFINITY, 0.0]])
+        .unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "point 1: coordinate 1 is inf, not a finite number"
+    );
     let mut t = PeriodicDelaunay3::new(torus);
     assert!(t.insert([f64::NAN, 0.0, 0.0]).is_err());
     assert!(t.locate([0.5; 3]).is_err());

@@ -124,7 +124,7 @@ impl FlatTorus3 {
         let same_offset = a.1 == b.1;
         for c in 0..3 {
             let decided = if same_offset {
-                Some(Sign::from(a.0[c].total_cmp(&b.0[c])))
+                a.0[c].partial_cmp(&b.0[c]).map(Sign::from)
             } else {
                 let dt = [
                     a.1[0] as i32 - b.1[0] as i32,

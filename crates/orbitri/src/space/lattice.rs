@@ -80,12 +80,21 @@ impl<const D: usize> Lattice<D> {
         }
         let rows = Rows { m, diagonal };
         let systole = shortest_vector(&rows, [1; D]);
-        Ok(Lattice {
+        let lattice = Lattice {
             rows,
             inv,
             systole,
             volume: det.abs(),
-        })
+        };
+        let h = lattice.covering();
+        if let Some(i) = (0..D).find(|&i| h[i] > MAX_COPIES) {
+            return Err(Error::InvalidBox(format!(
+                "too elongated: the covering space would need {} copies along vector {i} (at most {MAX_COPIES}); keep each edge above 1/{} of the box diagonal",
+                h[i],
+                MAX_COPIES / 2
+            )));
+        }
+        Ok(lattice)
     }
 
     /// The lattice vectors (rows).
@@ -134,6 +143,8 @@ impl<const D: usize> Lattice<D> {
     /// For a box, the result lies exactly in `[0, L)` per axis (a point on the upper face goes
     /// to 0); for a triclinic lattice the domain test uses rounded fractional coordinates.
     pub fn wrap(&self, x: [f64; D]) -> ([f64; D], bool) {
+        // `-0.0 + 0.0 = +0.0`: one zero, so that coordinate comparisons agree with geometry
+        let x = x.map(|v| v + 0.0);
         if self.rows.diagonal {
             let mut y = x;
             let mut moved = false;
@@ -192,7 +203,8 @@ impl<const D: usize> Lattice<D> {
         }
         let big = 2.0 * self.rows.m.iter().map(|r| dot(r, r)).sum::<f64>().sqrt() * (1.0 + 1e-9);
         // start below the answer and grow the copies along the currently shortest vector
-        let mut h: [i32; D] = std::array::from_fn(|i| ((big / norm(&self.rows.m[i])).floor() as i32).max(1));
+        let mut h: [i32; D] =
+            std::array::from_fn(|i| ((big / norm(&self.rows.m[i])).floor() as i32).max(1));
         while shortest_vector(&self.rows, h) <= big {
             let i = (0..D).min_by(|&a, &b| {
                 let la = h[a] as f64 * norm(&self.rows.m[a]);
@@ -363,6 +375,7 @@ mod tests {
         let b = Lattice::cuboid([1.0, 2.0, 1.0]).unwrap();
         assert_eq!(b.wrap([1.0, 2.0, -1e-20]), ([0.0, 0.0, 0.0], true));
         assert_eq!(b.wrap([0.5, 0.5, 0.5]), ([0.5, 0.5, 0.5], false));
+        assert!(b.wrap([-0.0, 0.5, 0.5]).0[0].is_sign_positive());
         assert_eq!(b.wrap([-0.25, 4.5, 3.75]).0, [0.75, 0.5, 0.75]);
         let t = Lattice::new([[1.0, 0.0, 0.0], [0.5, 1.0, 0.0], [0.3, 0.2, 0.9]]).unwrap();
         for x in [[2.3, -1.7, 5.1], [-0.1, -0.1, -0.1], [1.8, 1.2, 0.95]] {
