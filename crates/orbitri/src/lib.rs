@@ -14,6 +14,9 @@
 //! assert_eq!(tri.number_of_vertices(), 200);
 //! ```
 
+// Geometry code indexes coordinates and cell slots by number, as the formulas do.
+#![allow(clippy::needless_range_loop)]
+
 pub mod delaunay;
 pub mod error;
 pub mod io;

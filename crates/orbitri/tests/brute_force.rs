@@ -209,8 +209,8 @@ fn duplicates_and_wrapping_lose_nothing() {
         tri.points()[tri.vertex_of_input(503) as usize],
         [0.0, 0.25, 0.0]
     );
-    for i in 0..pts.len() {
-        assert_eq!(tri.input_of_vertex(tri.vertex_of_input(i)), first[i]);
+    for (i, f) in first.iter().enumerate() {
+        assert_eq!(tri.input_of_vertex(tri.vertex_of_input(i)), *f);
     }
 }
 

@@ -4,18 +4,14 @@
 
 use std::collections::HashMap;
 
-use super::Engine;
-use crate::space::{Lifted, OrbitSpace};
+use super::{Candidate, Engine, LiftedOf};
+use crate::space::OrbitSpace;
 use crate::tds::{Cell, Tds, NONE};
 
 impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// Candidates for gift wrapping: the lifted copies of the points near `at`,
     /// with their vertex ids (`sheets` ids per point in the covering, one in the quotient).
-    fn wrap_candidates(
-        &self,
-        at: Lifted<S::Point, S::Offset>,
-        radius: f64,
-    ) -> Vec<(u32, Lifted<S::Point, S::Offset>)> {
+    fn wrap_candidates(&self, at: LiftedOf<S, N>, radius: f64) -> Vec<Candidate<S, N>> {
         let mut near = Vec::new();
         self.space.near(at, &self.points, radius, &mut near);
         let sheets = if self.one_sheeted {
@@ -44,7 +40,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.one_sheeted = one_sheeted;
         let sheets = if one_sheeted { 1 } else { self.space.sheets() };
         self.vpoint = (0..self.points.len() as u32)
-            .flat_map(|p| std::iter::repeat(p).take(sheets))
+            .flat_map(|p| std::iter::repeat_n(p, sheets))
             .collect();
         self.vcell = vec![NONE; self.vpoint.len()];
         let radius = self.space.edge_bound(one_sheeted);

@@ -1,16 +1,16 @@
 //! Point location by a remembering stochastic walk, the conflict region by breadth-first
 //! search, and starring the hole.
 
-use super::{Engine, Inserted};
+use super::{Engine, Inserted, LiftedOf};
 use crate::predicates::Sign;
-use crate::space::{Lifted, OrbitSpace};
+use crate::space::OrbitSpace;
 use crate::tds::NONE;
 
 impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// The cell containing the lifted point `q`, and `q`'s offset in that cell's frame.
     /// Remembering stochastic walk: never step back through the facet just crossed, and try
     /// the facets in a random rotation.
-    pub fn locate_from(&mut self, q: Lifted<S::Point, S::Offset>, start: u32) -> (u32, S::Offset) {
+    pub fn locate_from(&mut self, q: LiftedOf<S, N>, start: u32) -> (u32, S::Offset) {
         let (p, mut qo) = q;
         let mut c = start;
         let mut prev = NONE;
@@ -149,7 +149,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// coincides with (checked only when `check_duplicate`).
     pub(crate) fn insert_lifted(
         &mut self,
-        q: Lifted<S::Point, S::Offset>,
+        q: LiftedOf<S, N>,
         x: u32,
         check_duplicate: bool,
     ) -> Result<(), u32> {

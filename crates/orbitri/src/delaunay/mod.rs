@@ -17,6 +17,14 @@ use crate::tds::{Cell, Tds, NONE};
 
 pub use validate::Invalid;
 
+/// A lifted point of the space `S` (cells of `N` vertices).
+pub type LiftedOf<S, const N: usize> =
+    Lifted<<S as OrbitSpace<N>>::Point, <S as OrbitSpace<N>>::Offset>;
+/// The lifted vertices of one cell.
+pub type LiftedCell<S, const N: usize> = [LiftedOf<S, N>; N];
+/// A vertex id with a lifted position.
+pub type Candidate<S, const N: usize> = (u32, LiftedOf<S, N>);
+
 /// Reusable buffers of one insertion or removal (no allocation per point).
 #[derive(Debug, Default)]
 struct Scratch<O> {
@@ -140,7 +148,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
 
     /// The lifted vertex `i` of cell `c`.
     #[inline]
-    pub fn lifted(&self, c: u32, i: usize) -> Lifted<S::Point, S::Offset> {
+    pub fn lifted(&self, c: u32, i: usize) -> LiftedOf<S, N> {
         let cell = &self.tds.cells[c as usize];
         (
             self.points[self.vpoint[cell.v[i] as usize] as usize],
@@ -150,7 +158,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
 
     /// All lifted vertices of cell `c`.
     #[inline]
-    pub fn lifted_cell(&self, c: u32) -> [Lifted<S::Point, S::Offset>; N] {
+    pub fn lifted_cell(&self, c: u32) -> LiftedCell<S, N> {
         std::array::from_fn(|i| self.lifted(c, i))
     }
 
@@ -174,7 +182,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.space.normalize(&mut off, self.one_sheeted);
         let id = self.tds.create(Cell::new(v, off));
         if !self.one_sheeted {
-            let s: [Lifted<S::Point, S::Offset>; N] =
+            let s: LiftedCell<S, N> =
                 std::array::from_fn(|i| (self.points[self.vpoint[v[i] as usize] as usize], off[i]));
             let big = self.space.circumradius2(&s) >= self.space.criterion_radius2();
             if self.big.len() <= id as usize {

@@ -2,8 +2,8 @@
 //! Delaunay triangulation of its link, found by gift wrapping over the star's vertices.
 
 use super::wrap::Owner;
-use super::Engine;
-use crate::space::{Lifted, OrbitSpace};
+use super::{Candidate, Engine, LiftedCell};
+use crate::space::OrbitSpace;
 use crate::tds::NONE;
 
 /// Why a removal was refused.
@@ -48,11 +48,11 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             }
             next += 1;
         }
-        let shifted = |e: &Self, c: u32, shift: S::Offset| -> [Lifted<S::Point, S::Offset>; N] {
+        let shifted = |e: &Self, c: u32, shift: S::Offset| -> LiftedCell<S, N> {
             e.lifted_cell(c)
                 .map(|(p, o)| (p, e.space.compose(o, shift)))
         };
-        let mut hole: Vec<(u32, Lifted<S::Point, S::Offset>)> = Vec::new();
+        let mut hole: Vec<Candidate<S, N>> = Vec::new();
         let mut seeds = Vec::with_capacity(star.len());
         for &(c, i, shift) in &star {
             let arr = shifted(self, c, shift);

@@ -9,6 +9,9 @@ use crate::predicates::Sign;
 use crate::space::OrbitSpace;
 use crate::tds::NONE;
 
+/// A face as sorted (vertex, offset) pairs.
+type FaceKey<O> = Vec<(u32, O)>;
+
 /// Why a triangulation is invalid.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 #[error("invalid triangulation: {0}")]
@@ -79,7 +82,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             }
         }
         // Euler characteristic of a closed 3-manifold (or of a torus) is 0
-        let mut faces: Vec<HashSet<Vec<(u32, S::Offset)>>> = vec![HashSet::new(); N];
+        let mut faces: Vec<HashSet<FaceKey<S::Offset>>> = vec![HashSet::new(); N];
         for c in self.tds.ids() {
             let cell = &self.tds.cells[c as usize];
             for mask in 1u32..(1 << N) {

@@ -5,10 +5,13 @@
 
 use std::collections::HashMap;
 
-use super::Engine;
+use super::{Candidate, Engine, LiftedCell};
 use crate::predicates::Sign;
 use crate::space::{Lifted, OrbitSpace};
 use crate::tds::NONE;
+
+/// A facet to close: vertex ids, lifted simplex, slot of the apex, side, owner.
+pub(super) type Seed<S, const N: usize> = ([u32; N], LiftedCell<S, N>, usize, bool, Owner);
 
 /// Who is on the other side of an open facet.
 #[derive(Clone, Copy, Debug)]
@@ -49,14 +52,14 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     fn pivot(
         &self,
         f: &Open<S::Point, S::Offset, N>,
-        cands: &[(u32, Lifted<S::Point, S::Offset>)],
-    ) -> Option<(u32, [Lifted<S::Point, S::Offset>; N])> {
+        cands: &[Candidate<S, N>],
+    ) -> Option<(u32, LiftedCell<S, N>)> {
         let want = if f.toward {
             Sign::Positive
         } else {
             Sign::Negative
         };
-        let mut best: Option<(u32, [Lifted<S::Point, S::Offset>; N])> = None;
+        let mut best: Option<(u32, LiftedCell<S, N>)> = None;
         for &(vid, y) in cands {
             if f.vids
                 .iter()
@@ -86,17 +89,8 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// `None` if some facet found no apex.
     pub(super) fn wrap(
         &self,
-        seeds: Vec<(
-            [u32; N],
-            [Lifted<S::Point, S::Offset>; N],
-            usize,
-            bool,
-            Owner,
-        )>,
-        mut candidates: impl FnMut(
-            &[Lifted<S::Point, S::Offset>; N],
-            usize,
-        ) -> Vec<(u32, Lifted<S::Point, S::Offset>)>,
+        seeds: Vec<Seed<S, N>>,
+        mut candidates: impl FnMut(&LiftedCell<S, N>, usize) -> Vec<Candidate<S, N>>,
         mut first: Vec<Wrapped<S::Point, S::Offset, N>>,
     ) -> Option<Vec<Wrapped<S::Point, S::Offset, N>>> {
         let mut open: HashMap<[u32; N], Open<S::Point, S::Offset, N>> = HashMap::new();
@@ -185,12 +179,11 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// cover its circumsphere, and empty.
     pub(super) fn first_cell(
         &self,
-        a: (u32, Lifted<S::Point, S::Offset>),
-        cands: &[(u32, Lifted<S::Point, S::Offset>)],
+        a: Candidate<S, N>,
+        cands: &[Candidate<S, N>],
         max_r2: f64,
     ) -> Option<Wrapped<S::Point, S::Offset, N>> {
-        let others: Vec<(u32, Lifted<S::Point, S::Offset>)> =
-            cands.iter().copied().filter(|c| c.0 != a.0).collect();
+        let others: Vec<Candidate<S, N>> = cands.iter().copied().filter(|c| c.0 != a.0).collect();
         let k = others.len();
         let mut pick = vec![0usize; N - 1];
         // enumerate (N−1)-subsets in colexicographic order: nearest candidates first
@@ -250,15 +243,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     }
 
     /// Seeds for wrapping outward from a first cell: its facets, owned by itself.
-    pub(super) fn seeds_of(
-        w: &Wrapped<S::Point, S::Offset, N>,
-    ) -> Vec<(
-        [u32; N],
-        [Lifted<S::Point, S::Offset>; N],
-        usize,
-        bool,
-        Owner,
-    )> {
+    pub(super) fn seeds_of(w: &Wrapped<S::Point, S::Offset, N>) -> Vec<Seed<S, N>> {
         (0..N)
             .map(|m| (w.vids, w.arr, m, false, Owner::New(0, m)))
             .collect()

@@ -67,7 +67,7 @@ impl<const D: usize> Lattice<D> {
 
     fn build(m: [[f64; D]; D], diagonal: bool) -> Result<Self> {
         let (det, inv) = invert(&m);
-        let norms: f64 = m.iter().map(|r| norm(r)).product();
+        let norms: f64 = m.iter().map(norm).product();
         if det == 0.0 || !det.is_finite() || det.abs() <= 1e-12 * norms {
             return Err(Error::SingularLattice { det: det.abs() });
         }

@@ -1,0 +1,251 @@
+//! The command as a user runs it: outputs, statistics, and errors with exit codes.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn orbitri(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_orbitri"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn random_text(n: usize) -> String {
+    let mut s = String::from("# x y z\n");
+    let mut x: u64 = 12345;
+    for _ in 0..n {
+        let mut c = [0.0; 3];
+        for v in c.iter_mut() {
+            x = x
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            *v = (x >> 11) as f64 / (1u64 << 53) as f64;
+        }
+        s.push_str(&format!("{}, {} {}\n", c[0], c[1], c[2]));
+    }
+    s
+}
+
+#[test]
+fn cells_output_matches_the_library() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = write(dir.path(), "pts.txt", &random_text(1200));
+    let out = dir.path().join("cells.txt");
+    let o = orbitri(&[
+        "triangulate",
+        input.to_str().unwrap(),
+        "--box",
+        "1",
+        "1",
+        "1",
+        "-o",
+        out.to_str().unwrap(),
+        "--stats",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(&out).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<usize> = lines
+        .next()
+        .unwrap()
+        .split(' ')
+        .map(|s| s.parse().unwrap())
+        .collect();
+    assert_eq!(header[0], 1);
+    assert_eq!(header[1], 1200);
+    let rows: Vec<Vec<i64>> = lines
+        .map(|l| l.split(' ').map(|s| s.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), header[2]);
+    assert!(rows
+        .iter()
+        .all(|r| r.len() == 16 && r[..4].iter().all(|&v| (0..1200).contains(&v))));
+    let pts: Vec<[f64; 3]> = orbitri::io::read_points(&input, 3)
+        .unwrap()
+        .iter()
+        .map(|r| [r[0], r[1], r[2]])
+        .collect();
+    let tri =
+        orbitri::PeriodicDelaunay3::build(orbitri::FlatTorus3::cuboid([1.0; 3]).unwrap(), &pts)
+            .unwrap();
+    assert_eq!(header[2], tri.number_of_cells());
+    let stats = stderr(&o);
+    for key in [
+        "vertices=1200 ",
+        "cells=",
+        "sheets=1 ",
+        "duplicates=0 ",
+        "wrapped=0 ",
+        "build_seconds=",
+        "peak_rss_kb=",
+    ] {
+        assert!(stats.contains(key), "missing {key} in {stats}");
+    }
+}
+
+#[test]
+fn json_npy_lattice_duplicates_and_wrapping() {
+    let dir = tempfile::tempdir().unwrap();
+    let rows = vec![
+        vec![0.1, 0.2, 0.3],
+        vec![1.1, 0.2, 0.3],
+        vec![0.5, 0.5, 0.5],
+        vec![0.9, 0.1, 0.7],
+        vec![0.3, 0.8, 0.2],
+    ];
+    let npy = dir.path().join("p.npy");
+    std::fs::write(&npy, orbitri::io::encode_npy(&rows, 3)).unwrap();
+    let o = orbitri(&[
+        "triangulate",
+        npy.to_str().unwrap(),
+        "--lattice",
+        "1",
+        "0",
+        "0",
+        "0.2",
+        "1",
+        "0",
+        "0",
+        "-0.1",
+        "1",
+        "--format",
+        "json",
+        "--stats",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let json = String::from_utf8(o.stdout.clone()).unwrap();
+    assert!(json.starts_with("{\"dimension\":3,\"sheets\":"), "{json}");
+    assert!(
+        json.contains("\"first_occurrence\":[0,1,2,3,4]")
+            || json.contains("\"first_occurrence\":[0,0,2,3,4]"),
+        "{json}"
+    );
+    assert!(stderr(&o).contains("wrapped=1"));
+}
+
+#[test]
+fn a_duplicate_takes_its_first_occurrence_id() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = write(
+        dir.path(),
+        "d.txt",
+        "0.25 0.25 0.25\n0.75 0.5 0.5\n1.25 0.25 0.25\n0.5 0.75 0.125\n0.125 0.5 0.875\n",
+    );
+    let o = orbitri(&[
+        "triangulate",
+        input.to_str().unwrap(),
+        "--box",
+        "1",
+        "1",
+        "1",
+        "--stats",
+    ]);
+    assert!(o.status.success());
+    let text = String::from_utf8(o.stdout.clone()).unwrap();
+    assert!(
+        text.lines()
+            .skip(1)
+            .all(|l| !l.split(' ').take(4).any(|v| v == "2")),
+        "id 2 is a duplicate of 0"
+    );
+    assert!(text.starts_with("27 4 "), "{}", &text[..20]);
+    assert!(stderr(&o).contains("duplicates=1"));
+}
+
+#[test]
+fn bad_input_gets_a_clear_error_and_exit_code_2() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases: Vec<(PathBuf, Vec<&str>, &str)> = vec![
+        (
+            write(dir.path(), "nan.txt", "0 0 0\n0.5 nan 0.5\n"),
+            vec!["--box", "1", "1", "1"],
+            "nan.txt:2: coordinate 1 is NaN",
+        ),
+        (
+            write(dir.path(), "inf.txt", "0 0 0\n\n0.5 0.5 -inf\n"),
+            vec!["--box", "1", "1", "1"],
+            "inf.txt:3: coordinate 2 is -inf",
+        ),
+        (
+            write(dir.path(), "cols.txt", "0 0 0\n0.5 0.5\n"),
+            vec!["--box", "1", "1", "1"],
+            "cols.txt:2: expected 3 coordinates, found 2",
+        ),
+        (
+            write(dir.path(), "word.txt", "0 0 zero\n"),
+            vec!["--box", "1", "1", "1"],
+            "word.txt:1: coordinate 2 'zero' is not a number",
+        ),
+        (
+            write(dir.path(), "empty.txt", "# nothing\n\n"),
+            vec!["--box", "1", "1", "1"],
+            "the file holds no points",
+        ),
+        (
+            write(dir.path(), "ok.txt", "0.5 0.5 0.5\n"),
+            vec!["--box", "1", "0", "1"],
+            "invalid box: length 1 is 0",
+        ),
+        (
+            write(dir.path(), "ok2.txt", "0.5 0.5 0.5\n"),
+            vec!["--box", "1", "-2", "1"],
+            "invalid box: length 1 is -2",
+        ),
+        (
+            write(dir.path(), "ok3.txt", "0.5 0.5 0.5\n"),
+            vec!["--lattice", "1", "0", "0", "0", "1", "0", "1", "1", "0"],
+            "singular lattice",
+        ),
+        (
+            write(dir.path(), "ok4.txt", "0.5 0.5 0.5\n"),
+            vec!["--lattice", "1", "0", "0", "30", "0.1", "0", "0", "0", "1"],
+            "lattice too skewed",
+        ),
+        (
+            dir.path().join("missing.txt"),
+            vec!["--box", "1", "1", "1"],
+            "missing.txt: No such file",
+        ),
+    ];
+    for (path, dom, msg) in cases {
+        let mut args = vec!["triangulate", path.to_str().unwrap()];
+        args.extend(dom);
+        let o = orbitri(&args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}");
+        assert!(stderr(&o).contains(msg), "{args:?}: {}", stderr(&o));
+    }
+    // clap: missing domain
+    let o = orbitri(&["triangulate", "x.txt"]);
+    assert!(!o.status.success());
+}
+
+#[test]
+fn generate_reproduces_the_anchor_points() {
+    let o = orbitri(&["generate", "2", "--seed", "1"]);
+    let text = String::from_utf8(o.stdout.clone()).unwrap();
+    assert_eq!(
+        text.lines().next().unwrap(),
+        "0.5665615751722809 0.7457817572627011 0.9710027535867962"
+    );
+}
+
+#[test]
+fn demo_runs() {
+    let o = orbitri(&["demo", "-n", "3000"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = String::from_utf8(o.stdout.clone()).unwrap();
+    assert!(
+        text.contains("vertices=3000") && text.contains("5184 cells"),
+        "{text}"
+    );
+}
