@@ -150,16 +150,28 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     #[inline]
     pub fn lifted(&self, c: u32, i: usize) -> LiftedOf<S, N> {
         let cell = &self.tds.cells[c as usize];
-        (
-            self.points[self.vpoint[cell.v[i] as usize] as usize],
-            cell.off[i],
-        )
+        (self.points[self.point_index(cell.v[i])], cell.off[i])
+    }
+
+    /// The point of vertex `v` (the identity once 1-sheeted: no indirection on the hot path).
+    #[inline]
+    fn point_index(&self, v: u32) -> usize {
+        if self.one_sheeted {
+            v as usize
+        } else {
+            self.vpoint[v as usize] as usize
+        }
     }
 
     /// All lifted vertices of cell `c`.
     #[inline]
     pub fn lifted_cell(&self, c: u32) -> LiftedCell<S, N> {
-        std::array::from_fn(|i| self.lifted(c, i))
+        let cell = &self.tds.cells[c as usize];
+        let mut out = [(self.points[0], cell.off[0]); N];
+        for i in 0..N {
+            out[i] = (self.points[self.point_index(cell.v[i])], cell.off[i]);
+        }
+        out
     }
 
     /// The offset that maps the frame of `d = neighbour(c, i)` onto the frame of `c`.
@@ -167,6 +179,10 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     pub fn translation(&self, c: u32, i: usize, d: u32) -> S::Offset {
         let cc = &self.tds.cells[c as usize];
         let dc = &self.tds.cells[d as usize];
+        let zero = S::Offset::default();
+        if cc.off.iter().all(|&o| o == zero) && dc.off.iter().all(|&o| o == zero) {
+            return zero;
+        }
         let k = (i + 1) % N;
         let j = dc.index_of(cc.v[k]).expect("neighbours share a facet");
         self.space.difference(cc.off[k], dc.off[j])

@@ -80,6 +80,19 @@ pub fn lifted_diff<const D: usize>(
     (d, b)
 }
 
+/// `p − p0` for two points in the same frame, with the same bound convention as
+/// [`lifted_diff`] (here the error is at most `u·B`).
+#[inline]
+pub fn plain_diff<const D: usize>(p: &[f64; D], p0: &[f64; D]) -> ([f64; D], f64) {
+    let mut d = [0.0; D];
+    let mut b = 0.0f64;
+    for c in 0..D {
+        d[c] = p[c] - p0[c];
+        b = b.max(d[c].abs());
+    }
+    (d, b)
+}
+
 #[inline]
 fn in_range(b: f64) -> bool {
     (TINY..=HUGE).contains(&b) || b == 0.0

@@ -6,7 +6,7 @@ use num_bigint::BigInt;
 use super::{Lattice, Lifted, OrbitSpace};
 use crate::error::Result;
 use crate::predicates::exact::{self, Scaled};
-use crate::predicates::filter::{self, lifted_diff};
+use crate::predicates::filter::{self, lifted_diff, plain_diff};
 use crate::predicates::Sign;
 
 /// An integer offset vector in lattice-vector units.
@@ -190,24 +190,37 @@ impl OrbitSpace<4> for FlatTorus3 {
 
     #[inline]
     fn orient(&self, s: &[L3; 4]) -> Sign {
-        let rows = &self.lattice.rows;
-        let t0 = widen(s[0].1);
         let mut d = [[0.0; 3]; 3];
         let mut b = [0.0; 3];
-        for i in 0..3 {
-            (d[i], b[i]) = lifted_diff(rows, &s[i + 1].0, widen(s[i + 1].1), &s[0].0, t0);
+        if s.iter().all(|x| x.1 == s[0].1) {
+            // the common case: one frame, plain differences (translation invariance)
+            for i in 0..3 {
+                (d[i], b[i]) = plain_diff(&s[i + 1].0, &s[0].0);
+            }
+        } else {
+            let rows = &self.lattice.rows;
+            let t0 = widen(s[0].1);
+            for i in 0..3 {
+                (d[i], b[i]) = lifted_diff(rows, &s[i + 1].0, widen(s[i + 1].1), &s[0].0, t0);
+            }
         }
         filter::orient3(&d, b).unwrap_or_else(|| self.orient_exact(s))
     }
 
     #[inline]
     fn in_sphere(&self, s: &[L3; 4], q: L3) -> Sign {
-        let rows = &self.lattice.rows;
-        let tq = widen(q.1);
         let mut d = [[0.0; 3]; 4];
         let mut b = [0.0; 4];
-        for i in 0..4 {
-            (d[i], b[i]) = lifted_diff(rows, &s[i].0, widen(s[i].1), &q.0, tq);
+        if s.iter().all(|x| x.1 == q.1) {
+            for i in 0..4 {
+                (d[i], b[i]) = plain_diff(&s[i].0, &q.0);
+            }
+        } else {
+            let rows = &self.lattice.rows;
+            let tq = widen(q.1);
+            for i in 0..4 {
+                (d[i], b[i]) = lifted_diff(rows, &s[i].0, widen(s[i].1), &q.0, tq);
+            }
         }
         match filter::in_sphere3(&d, b).unwrap_or_else(|| self.in_sphere_exact(s, q)) {
             Sign::Zero => self.perturbed(s, q),

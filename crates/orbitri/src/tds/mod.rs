@@ -5,12 +5,14 @@
 /// Marks a missing id.
 pub const NONE: u32 = u32::MAX;
 
-/// A cell: vertex ids, neighbour ids, and the offset of each vertex.
+/// A cell: vertex ids, neighbour ids, the offset of each vertex, and a visit stamp (kept
+/// in the cell so that a visit touches one cache line).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Cell<O, const N: usize> {
     pub v: [u32; N],
     pub n: [u32; N],
     pub off: [O; N],
+    stamp: u32,
 }
 
 impl<O: Copy + Default, const N: usize> Cell<O, N> {
@@ -20,6 +22,7 @@ impl<O: Copy + Default, const N: usize> Cell<O, N> {
             v,
             n: [NONE; N],
             off,
+            stamp: 0,
         }
     }
 
@@ -41,7 +44,6 @@ impl<O: Copy + Default, const N: usize> Cell<O, N> {
 pub struct Tds<O, const N: usize> {
     pub cells: Vec<Cell<O, N>>,
     free: Vec<u32>,
-    stamp: Vec<u32>,
     generation: u32,
 }
 
@@ -51,7 +53,6 @@ impl<O: Copy + Default, const N: usize> Tds<O, N> {
         Tds {
             cells: Vec::new(),
             free: Vec::new(),
-            stamp: Vec::new(),
             generation: 0,
         }
     }
@@ -60,11 +61,12 @@ impl<O: Copy + Default, const N: usize> Tds<O, N> {
     #[inline]
     pub fn create(&mut self, c: Cell<O, N>) -> u32 {
         if let Some(id) = self.free.pop() {
-            self.cells[id as usize] = c;
+            // keep the old stamp: it belongs to an earlier visit
+            let stamp = self.cells[id as usize].stamp;
+            self.cells[id as usize] = Cell { stamp, ..c };
             id
         } else {
             self.cells.push(c);
-            self.stamp.push(0);
             (self.cells.len() - 1) as u32
         }
     }
@@ -101,7 +103,7 @@ impl<O: Copy + Default, const N: usize> Tds<O, N> {
     #[inline]
     pub fn new_visit(&mut self) -> (u32, u32) {
         if self.generation >= u32::MAX - 4 {
-            self.stamp.iter_mut().for_each(|s| *s = 0);
+            self.cells.iter_mut().for_each(|c| c.stamp = 0);
             self.generation = 0;
         }
         self.generation += 2;
@@ -111,26 +113,24 @@ impl<O: Copy + Default, const N: usize> Tds<O, N> {
     /// The stamp of a cell.
     #[inline]
     pub fn stamp(&self, id: u32) -> u32 {
-        self.stamp[id as usize]
+        self.cells[id as usize].stamp
     }
 
     /// Sets the stamp of a cell.
     #[inline]
     pub fn set_stamp(&mut self, id: u32, s: u32) {
-        self.stamp[id as usize] = s;
+        self.cells[id as usize].stamp = s;
     }
 
     /// Drops every cell.
     pub fn clear(&mut self) {
         self.cells.clear();
         self.free.clear();
-        self.stamp.clear();
     }
 
     /// Reserves room for `n` more cells.
     pub fn reserve(&mut self, n: usize) {
         self.cells.reserve(n);
-        self.stamp.reserve(n);
     }
 }
 
