@@ -156,6 +156,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             self.attach(k);
         }
         self.hint = 0;
+        self.hint_shift = S::Offset::default();
     }
 
     /// Drops the first `k` points (the dummies, once removed) and renumbers the rest.

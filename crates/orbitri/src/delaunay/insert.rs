@@ -41,8 +41,8 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
 
     /// The cell containing the point (offset 0), starting from the last insertion.
     pub fn locate(&mut self, p: S::Point) -> (u32, S::Offset) {
-        let start = self.start_cell();
-        self.locate_from((p, S::Offset::default()), start)
+        let (start, shift) = self.start_cell();
+        self.locate_from((p, shift), start)
     }
 
     /// Collects the cells whose circumsphere contains `q` (starting at `c0`, which contains
@@ -79,8 +79,9 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.scratch = scratch;
     }
 
-    /// Replaces the conflict region by the cone from the new vertex `x` over its boundary.
-    fn star_hole(&mut self, x: u32) {
+    /// Replaces the conflict region by the cone from the new vertex `x` (lifted with offset
+    /// `qoff` as inserted) over its boundary.
+    fn star_hole(&mut self, x: u32, qoff: S::Offset) {
         let mut scratch = std::mem::take(&mut self.scratch);
         let inside = self.tds.stamp(scratch.conflict[0].0);
         scratch.created.clear();
@@ -141,7 +142,14 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         for &nc in &scratch.created {
             self.attach(nc);
         }
-        self.hint = scratch.created[0];
+        let first = scratch.created[0];
+        let k = self.tds.cells[first as usize]
+            .index_of(x)
+            .expect("new cells hold the new vertex");
+        self.hint = first;
+        self.hint_shift = self
+            .space
+            .difference(self.tds.cells[first as usize].off[k], qoff);
         self.scratch = scratch;
     }
 
@@ -153,18 +161,19 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         x: u32,
         check_duplicate: bool,
     ) -> Result<(), u32> {
-        let start = self.start_cell();
-        let (c, qo) = self.locate_from(q, start);
+        let (start, shift) = self.start_cell();
+        let (c, qo) = self.locate_from((q.0, self.space.compose(q.1, shift)), start);
         if check_duplicate {
             for i in 0..N {
                 if self.space.coincide(self.lifted(c, i), (q.0, qo)) {
                     self.hint = c;
+                    self.hint_shift = self.space.difference(qo, q.1);
                     return Err(self.tds.cells[c as usize].v[i]);
                 }
             }
         }
         self.find_conflicts(c, qo, q.0);
-        self.star_hole(x);
+        self.star_hole(x, q.1);
         Ok(())
     }
 

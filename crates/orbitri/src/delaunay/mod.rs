@@ -64,6 +64,10 @@ pub struct Engine<S: OrbitSpace<N>, const N: usize> {
     big: Vec<bool>,
     big_count: usize,
     hint: u32,
+    /// Where the last inserted point sits in the hint cell's frame, relative to its own
+    /// offset: the next query (spatially close) starts its walk lifted by this translation,
+    /// not a period away when the hint cell straddles the domain boundary.
+    hint_shift: S::Offset,
     rng: SplitMix,
     scratch: Scratch<S::Offset>,
 }
@@ -82,6 +86,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             big: Vec::new(),
             big_count: 0,
             hint: 0,
+            hint_shift: S::Offset::default(),
             rng: SplitMix::new(0x5eed),
             scratch: Scratch::default(),
         }
@@ -235,15 +240,19 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.tds.cells[b as usize].n[j] = a;
     }
 
-    /// A live cell to start a walk from.
-    fn start_cell(&self) -> u32 {
+    /// A live cell to start a walk from, and the translation to apply to a query near the
+    /// last inserted point.
+    fn start_cell(&self) -> (u32, S::Offset) {
         if self.hint != NONE
             && (self.hint as usize) < self.tds.cells.len()
             && self.tds.is_alive(self.hint)
         {
-            self.hint
+            (self.hint, self.hint_shift)
         } else {
-            self.tds.ids().next().expect("a non-empty triangulation")
+            (
+                self.tds.ids().next().expect("a non-empty triangulation"),
+                S::Offset::default(),
+            )
         }
     }
 }

@@ -171,6 +171,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             self.attach(id);
         }
         self.hint = ids[0];
+        self.hint_shift = S::Offset::default();
         ids
     }
 
