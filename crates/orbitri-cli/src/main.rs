@@ -168,8 +168,7 @@ fn writer(path: &Option<PathBuf>) -> Result<Box<dyn Write>, CliError> {
 
 fn triangulate(input: PathBuf, domain: Domain, out: Output) -> Result<(), CliError> {
     let space = space(&domain)?;
-    let rows = orbitri::io::read_points(&input, 3)?;
-    let pts: Vec<[f64; 3]> = rows.iter().map(|r| [r[0], r[1], r[2]]).collect();
+    let pts: Vec<[f64; 3]> = orbitri::io::read_points(&input)?;
     let (tri, secs) = build(space, &pts)?;
     let path = out
         .output

@@ -70,11 +70,7 @@ fn cells_output_matches_the_library() {
     assert!(rows
         .iter()
         .all(|r| r.len() == 16 && r[..4].iter().all(|&v| (0..1200).contains(&v))));
-    let pts: Vec<[f64; 3]> = orbitri::io::read_points(&input, 3)
-        .unwrap()
-        .iter()
-        .map(|r| [r[0], r[1], r[2]])
-        .collect();
+    let pts: Vec<[f64; 3]> = orbitri::io::read_points(&input).unwrap();
     let tri =
         orbitri::PeriodicDelaunay3::build(orbitri::FlatTorus3::cuboid([1.0; 3]).unwrap(), &pts)
             .unwrap();
@@ -97,14 +93,14 @@ fn cells_output_matches_the_library() {
 fn json_npy_lattice_duplicates_and_wrapping() {
     let dir = tempfile::tempdir().unwrap();
     let rows = vec![
-        vec![0.1, 0.2, 0.3],
-        vec![1.1, 0.2, 0.3],
-        vec![0.5, 0.5, 0.5],
-        vec![0.9, 0.1, 0.7],
-        vec![0.3, 0.8, 0.2],
+        [0.1, 0.2, 0.3],
+        [1.1, 0.2, 0.3],
+        [0.5, 0.5, 0.5],
+        [0.9, 0.1, 0.7],
+        [0.3, 0.8, 0.2],
     ];
     let npy = dir.path().join("p.npy");
-    std::fs::write(&npy, orbitri::io::encode_npy(&rows, 3)).unwrap();
+    std::fs::write(&npy, orbitri::io::encode_npy(&rows)).unwrap();
     let o = orbitri(&[
         "triangulate",
         npy.to_str().unwrap(),

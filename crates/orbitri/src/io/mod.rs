@@ -12,15 +12,15 @@ use std::path::Path;
 
 use crate::error::Result;
 
-/// Reads `dim`-dimensional points from a text file or, for a `.npy` name, a float64 array
-/// of shape `(N, dim)`.
-pub fn read_points(path: &Path, dim: usize) -> Result<Vec<Vec<f64>>> {
+/// Reads `D`-dimensional points from a text file or, for a `.npy` name, a float64 array
+/// of shape `(N, D)`.
+pub fn read_points<const D: usize>(path: &Path) -> Result<Vec<[f64; D]>> {
     if path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("npy"))
     {
-        read_npy(path, dim)
+        read_npy(path)
     } else {
-        read_text(path, dim)
+        read_text(path)
     }
 }

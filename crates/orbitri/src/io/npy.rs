@@ -4,13 +4,13 @@ use std::path::Path;
 
 use crate::error::{Error, Result};
 
-/// Reads an `(N, dim)` float64 array.
-pub fn read_npy(path: &Path, dim: usize) -> Result<Vec<Vec<f64>>> {
+/// Reads an `(N, D)` float64 array.
+pub fn read_npy<const D: usize>(path: &Path) -> Result<Vec<[f64; D]>> {
     let bytes = std::fs::read(path).map_err(|source| Error::Io {
         file: path.to_path_buf(),
         source,
     })?;
-    parse_npy(&bytes, path, dim)
+    parse_npy(&bytes, path)
 }
 
 fn header_value<'a>(header: &'a str, key: &str) -> Option<&'a str> {
@@ -24,7 +24,8 @@ fn header_value<'a>(header: &'a str, key: &str) -> Option<&'a str> {
     Some(rest[..end].trim())
 }
 
-fn parse_npy(bytes: &[u8], path: &Path, dim: usize) -> Result<Vec<Vec<f64>>> {
+fn parse_npy<const D: usize>(bytes: &[u8], path: &Path) -> Result<Vec<[f64; D]>> {
+    let dim = D;
     let err = |message: String| Error::Parse {
         file: path.to_path_buf(),
         line: 1,
@@ -86,7 +87,7 @@ fn parse_npy(bytes: &[u8], path: &Path, dim: usize) -> Result<Vec<Vec<f64>>> {
     }
     let mut out = Vec::with_capacity(n);
     for i in 0..n {
-        let mut p = Vec::with_capacity(dim);
+        let mut p = [0.0; D];
         for axis in 0..dim {
             let k = (i * dim + axis) * 8;
             let b: [u8; 8] = data[k..k + 8].try_into().unwrap();
@@ -100,17 +101,17 @@ fn parse_npy(bytes: &[u8], path: &Path, dim: usize) -> Result<Vec<Vec<f64>>> {
                     "row {i}, coordinate {axis} is {v}, not a finite number"
                 )));
             }
-            p.push(v);
+            p[axis] = v;
         }
         out.push(p);
     }
     Ok(out)
 }
 
-/// Encodes an `(N, dim)` float64 array as `.npy` (used by tests and tools).
-pub fn encode_npy(rows: &[Vec<f64>], dim: usize) -> Vec<u8> {
+/// Encodes an `(N, D)` float64 array as `.npy` (used by tests and tools).
+pub fn encode_npy<const D: usize>(rows: &[[f64; D]]) -> Vec<u8> {
     let mut header = format!(
-        "{{'descr': '<f8', 'fortran_order': False, 'shape': ({}, {dim}), }}",
+        "{{'descr': '<f8', 'fortran_order': False, 'shape': ({}, {D}), }}",
         rows.len()
     );
     while (10 + header.len() + 1) % 64 != 0 {
@@ -134,26 +135,26 @@ mod tests {
 
     #[test]
     fn round_trip_and_errors() {
-        let rows = vec![vec![0.1, 0.2, 0.3], vec![1.0, 2.0, 3.0]];
-        let b = encode_npy(&rows, 3);
-        assert_eq!(parse_npy(&b, Path::new("a.npy"), 3).unwrap(), rows);
-        let e = parse_npy(&b, Path::new("a.npy"), 2)
+        let rows = vec![[0.1, 0.2, 0.3], [1.0, 2.0, 3.0]];
+        let b = encode_npy(&rows);
+        assert_eq!(parse_npy::<3>(&b, Path::new("a.npy")).unwrap(), rows);
+        let e = parse_npy::<2>(&b, Path::new("a.npy"))
             .unwrap_err()
             .to_string();
         assert!(e.contains("expected (N, 2)"), "{e}");
-        let e = parse_npy(b"hello world", Path::new("a.npy"), 3)
+        let e = parse_npy::<3>(b"hello world", Path::new("a.npy"))
             .unwrap_err()
             .to_string();
         assert!(e.contains("bad magic"), "{e}");
-        let nan = encode_npy(&[vec![0.0, f64::NAN, 0.0]], 3);
-        let e = parse_npy(&nan, Path::new("a.npy"), 3)
+        let nan = encode_npy(&[[0.0, f64::NAN, 0.0]]);
+        let e = parse_npy::<3>(&nan, Path::new("a.npy"))
             .unwrap_err()
             .to_string();
         assert!(e.contains("row 0, coordinate 1 is NaN"), "{e}");
         let truncated = &b[..b.len() - 4];
-        assert!(parse_npy(truncated, Path::new("a.npy"), 3)
+        let e = parse_npy::<3>(truncated, Path::new("a.npy"))
             .unwrap_err()
-            .to_string()
-            .contains("truncated"));
+            .to_string();
+        assert!(e.contains("truncated"), "{e}");
     }
 }

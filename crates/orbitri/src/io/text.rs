@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use crate::error::{Error, Result};
 
 /// Reads a text point file.
-pub fn read_text(path: &Path, dim: usize) -> Result<Vec<Vec<f64>>> {
+pub fn read_text<const D: usize>(path: &Path) -> Result<Vec<[f64; D]>> {
     let bytes = std::fs::read(path).map_err(|source| Error::Io {
         file: path.to_path_buf(),
         source,
@@ -19,11 +19,11 @@ pub fn read_text(path: &Path, dim: usize) -> Result<Vec<Vec<f64>>> {
             .count(),
         message: "not UTF-8 text (for binary input use a .npy file)".into(),
     })?;
-    parse_text(&text, path, dim)
+    parse_text(&text, path)
 }
 
 /// Parses text points; `file` is only used in error messages.
-pub fn parse_text(text: &str, file: &Path, dim: usize) -> Result<Vec<Vec<f64>>> {
+pub fn parse_text<const D: usize>(text: &str, file: &Path) -> Result<Vec<[f64; D]>> {
     let err = |line: usize, message: String| Error::Parse {
         file: PathBuf::from(file),
         line,
@@ -40,17 +40,17 @@ pub fn parse_text(text: &str, file: &Path, dim: usize) -> Result<Vec<Vec<f64>>> 
         if fields.is_empty() {
             continue;
         }
-        if fields.len() != dim {
+        if fields.len() != D {
             return Err(err(
                 line,
                 format!(
-                    "expected {dim} coordinates, found {} ({:?})",
+                    "expected {D} coordinates, found {} ({:?})",
                     fields.len(),
                     body.trim()
                 ),
             ));
         }
-        let mut p = Vec::with_capacity(dim);
+        let mut p = [0.0; D];
         for (axis, f) in fields.iter().enumerate() {
             let v: f64 = f
                 .parse()
@@ -61,7 +61,7 @@ pub fn parse_text(text: &str, file: &Path, dim: usize) -> Result<Vec<Vec<f64>>> 
                     format!("coordinate {axis} is {v}, not a finite number"),
                 ));
             }
-            p.push(v);
+            p[axis] = v;
         }
         out.push(p);
     }
@@ -78,21 +78,14 @@ pub fn parse_text(text: &str, file: &Path, dim: usize) -> Result<Vec<Vec<f64>>> 
 mod tests {
     use super::*;
 
-    fn parse(s: &str) -> Result<Vec<Vec<f64>>> {
-        parse_text(s, Path::new("in.txt"), 3)
+    fn parse(s: &str) -> Result<Vec<[f64; 3]>> {
+        parse_text(s, Path::new("in.txt"))
     }
 
     #[test]
     fn comments_commas_blanks() {
         let p = parse("# header\n0.1 0.2 0.3\n\n0.4,0.5, 0.6  # trailing\n1e-3\t2 3\n").unwrap();
-        assert_eq!(
-            p,
-            vec![
-                vec![0.1, 0.2, 0.3],
-                vec![0.4, 0.5, 0.6],
-                vec![1e-3, 2.0, 3.0]
-            ]
-        );
+        assert_eq!(p, vec![[0.1, 0.2, 0.3], [0.4, 0.5, 0.6], [1e-3, 2.0, 3.0]]);
     }
 
     #[test]
