@@ -1,75 +1,89 @@
 //! Text points: one point per line, coordinates separated by blanks or commas, `#` starts a
 //! comment, blank lines are skipped.
 
+use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 
 use crate::error::{Error, Result};
 
-/// Reads a text point file.
+/// Reads a text point file, streaming it line by line.
 pub fn read_text<const D: usize>(path: &Path) -> Result<Vec<[f64; D]>> {
-    let bytes = std::fs::read(path).map_err(|source| Error::Io {
+    let file = std::fs::File::open(path).map_err(|source| Error::Io {
         file: path.to_path_buf(),
         source,
     })?;
-    let text = String::from_utf8(bytes).map_err(|e| Error::Parse {
-        file: path.to_path_buf(),
-        line: 1 + e.as_bytes()[..e.utf8_error().valid_up_to()]
-            .iter()
-            .filter(|&&b| b == b'\n')
-            .count(),
-        message: "not UTF-8 text (for binary input use a .npy file)".into(),
-    })?;
-    parse_text(&text, path)
+    parse_lines(BufReader::new(file), path)
 }
 
 /// Parses text points; `file` is only used in error messages.
 pub fn parse_text<const D: usize>(text: &str, file: &Path) -> Result<Vec<[f64; D]>> {
+    parse_lines(text.as_bytes(), file)
+}
+
+fn parse_lines<const D: usize>(mut input: impl BufRead, file: &Path) -> Result<Vec<[f64; D]>> {
     let err = |line: usize, message: String| Error::Parse {
         file: PathBuf::from(file),
         line,
         message,
     };
     let mut out = Vec::new();
-    for (k, raw) in text.lines().enumerate() {
-        let line = k + 1;
+    let mut buf = Vec::new();
+    let mut line = 0;
+    loop {
+        buf.clear();
+        let n = input
+            .read_until(b'\n', &mut buf)
+            .map_err(|source| Error::Io {
+                file: PathBuf::from(file),
+                source,
+            })?;
+        if n == 0 {
+            break;
+        }
+        line += 1;
+        let raw = std::str::from_utf8(&buf).map_err(|_| {
+            err(
+                line,
+                "not UTF-8 text (for binary input use a .npy file)".into(),
+            )
+        })?;
         let body = raw.split('#').next().unwrap_or("");
-        let fields: Vec<&str> = body
+        let mut p = [0.0; D];
+        let mut count = 0;
+        for f in body
             .split(|c: char| c == ',' || c.is_whitespace())
             .filter(|s| !s.is_empty())
-            .collect();
-        if fields.is_empty() {
+        {
+            if count < D {
+                let v: f64 = f
+                    .parse()
+                    .map_err(|_| err(line, format!("coordinate {count} '{f}' is not a number")))?;
+                if !v.is_finite() {
+                    return Err(err(
+                        line,
+                        format!("coordinate {count} is {v}, not a finite number"),
+                    ));
+                }
+                p[count] = v;
+            }
+            count += 1;
+        }
+        if count == 0 {
             continue;
         }
-        if fields.len() != D {
+        if count != D {
             return Err(err(
                 line,
                 format!(
-                    "expected {D} coordinates, found {} ({:?})",
-                    fields.len(),
+                    "expected {D} coordinates, found {count} ({:?})",
                     body.trim()
                 ),
             ));
         }
-        let mut p = [0.0; D];
-        for (axis, f) in fields.iter().enumerate() {
-            let v: f64 = f
-                .parse()
-                .map_err(|_| err(line, format!("coordinate {axis} '{f}' is not a number")))?;
-            if !v.is_finite() {
-                return Err(err(
-                    line,
-                    format!("coordinate {axis} is {v}, not a finite number"),
-                ));
-            }
-            p[axis] = v;
-        }
         out.push(p);
     }
     if out.is_empty() {
-        return Err(err(
-            text.lines().count().max(1),
-            "the file holds no points".into(),
-        ));
+        return Err(err(line.max(1), "the file holds no points".into()));
     }
     Ok(out)
 }
@@ -101,6 +115,10 @@ mod tests {
         assert_eq!(e, "in.txt:1: coordinate 2 'x1' is not a number");
         let e = parse("1 2 inf\n").unwrap_err().to_string();
         assert_eq!(e, "in.txt:1: coordinate 2 is inf, not a finite number");
+        let e = parse_lines::<3>(&b"0 0 0\n\xff\n"[..], Path::new("in.txt"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("in.txt:2: not UTF-8"), "{e}");
         let e = parse("# only a comment\n").unwrap_err().to_string();
         assert_eq!(e, "in.txt:1: the file holds no points");
     }
