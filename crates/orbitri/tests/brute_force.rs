@@ -339,3 +339,65 @@ fn bad_input_is_rejected_with_the_place() {
     assert!(t.insert([f64::NAN, 0.0, 0.0]).is_err());
     assert!(t.locate([0.5; 3]).is_err());
 }
+
+fn gaussian_clusters(clusters: usize, per: usize, sigma: f64, seed: u64) -> Vec<[f64; 3]> {
+    let mut r = SplitMix::new(seed);
+    let centers: Vec<[f64; 3]> = (0..clusters)
+        .map(|_| [r.unit(), r.unit(), r.unit()])
+        .collect();
+    let mut out = Vec::new();
+    for i in 0..clusters * per {
+        let c = centers[i % clusters];
+        out.push(std::array::from_fn(|k| {
+            let g =
+                (-2.0 * (1.0 - r.unit()).ln()).sqrt() * (std::f64::consts::TAU * r.unit()).cos();
+            (c[k] + sigma * g).rem_euclid(1.0) % 1.0
+        }));
+    }
+    out
+}
+
+#[test]
+fn clustered_points_keep_the_dummy_start_without_the_criterion() {
+    // 20 clusters: large empty balls remain once the dummies are gone, so the criterion
+    // fails, but the quotient is still a triangulation (no cycle of length ≤ 2)
+    let pts = gaussian_clusters(20, 40, 0.02, 5);
+    let opts = BuildOptions {
+        dummy_threshold: 300,
+        ..Default::default()
+    };
+    let tri = build(FlatTorus3::cuboid([1.0; 3]).unwrap(), &pts, opts);
+    assert!(tri.used_dummy_points());
+    assert_eq!(tri.sheets(), 1);
+    assert!(!tri.engine().criterion_holds());
+    let covering = build(
+        FlatTorus3::cuboid([1.0; 3]).unwrap(),
+        &pts,
+        BuildOptions {
+            dummy_threshold: usize::MAX,
+            ..Default::default()
+        },
+    );
+    assert_eq!(
+        canonical_cells(&tri.cells(Copies::Unique)),
+        canonical_cells(&covering.cells(Copies::Unique))
+    );
+    // more points into the quotient that is a triangulation without the criterion
+    let mut tri = tri;
+    let extra = uniform(200, 31, [1.0; 3]);
+    for p in &extra {
+        tri.insert(*p).unwrap();
+    }
+    tri.is_valid().unwrap();
+    let all: Vec<[f64; 3]> = pts.iter().chain(extra.iter()).copied().collect();
+    brute_force_check(&tri, &all);
+    let bulk = build(
+        FlatTorus3::cuboid([1.0; 3]).unwrap(),
+        &all,
+        BuildOptions::default(),
+    );
+    assert_eq!(
+        canonical_cells(&tri.cells(Copies::Unique)),
+        canonical_cells(&bulk.cells(Copies::Unique))
+    );
+}

@@ -37,6 +37,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.tds.clear();
         self.big.clear();
         self.big_count = 0;
+        self.guaranteed = false;
         self.one_sheeted = one_sheeted;
         let sheets = if one_sheeted { 1 } else { self.space.sheets() };
         self.vpoint = (0..self.points.len() as u32)
@@ -66,7 +67,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.bootstrap(false);
         if self.big_count == 0 {
             self.convert_to_one_sheet();
-            self.guaranteed = true;
+            self.set_guaranteed(true);
         }
     }
 
@@ -74,7 +75,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// (the dummy point set does by construction).
     pub(crate) fn bootstrap_one_sheeted(&mut self) {
         self.bootstrap(true);
-        self.guaranteed = true;
+        self.set_guaranteed(true);
     }
 
     /// Rebuilds the triangulation of the current points in the covering space.
@@ -179,7 +180,9 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     pub fn try_one_sheet(&mut self) -> bool {
         if !self.one_sheeted && !self.points.is_empty() && self.quotient_is_simplicial() {
             self.convert_to_one_sheet();
-            self.guaranteed = false;
+            if self.big_count == 0 {
+                self.set_guaranteed(true);
+            }
         }
         self.one_sheeted
     }

@@ -6,6 +6,14 @@ use crate::predicates::Sign;
 use crate::space::OrbitSpace;
 use crate::tds::NONE;
 
+/// Why a lifted point was not inserted.
+pub(crate) enum Refused {
+    /// It coincides with this vertex.
+    Duplicate(u32),
+    /// Starring its conflict region would break the quotient (1-sheeted without criterion).
+    NotSimplicial,
+}
+
 impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// The cell containing the lifted point `q`, and `q`'s offset in that cell's frame.
     /// Remembering stochastic walk: never step back through the facet just crossed, and try
@@ -153,14 +161,43 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.scratch = scratch;
     }
 
-    /// Inserts the lifted point `q` of point `point` as vertex `x`, or reports the vertex it
-    /// coincides with (checked only when `check_duplicate`).
+    /// True when starring the current conflict region keeps the quotient a simplicial
+    /// complex, for a 1-sheeted triangulation without the criterion: every conflict sphere
+    /// holds a single lift of the new point, and the new edges (all at the new point) join it
+    /// to each neighbour with one offset only (no cycle of length ≤ 2, Theorem 2.2.8).
+    fn star_keeps_simplicial(&self) -> bool {
+        let limit = self.space.single_lift_radius2();
+        if self
+            .scratch
+            .conflict
+            .iter()
+            .any(|&(c, _)| self.space.circumradius2(&self.lifted_cell(c)) >= limit)
+        {
+            return false;
+        }
+        let mut seen: Vec<(u32, S::Offset)> = Vec::new();
+        for &(ci, i) in &self.scratch.boundary {
+            let (c, qo) = self.scratch.conflict[ci as usize];
+            let cell = &self.tds.cells[c as usize];
+            for k in (0..N).filter(|&k| k != i as usize) {
+                let rel = self.space.difference(cell.off[k], qo);
+                match seen.iter().find(|e| e.0 == cell.v[k]) {
+                    Some(e) if e.1 != rel => return false,
+                    Some(_) => {}
+                    None => seen.push((cell.v[k], rel)),
+                }
+            }
+        }
+        true
+    }
+
+    /// Inserts the lifted point `q` of point `point` as vertex `x`, or says why not.
     pub(crate) fn insert_lifted(
         &mut self,
         q: LiftedOf<S, N>,
         x: u32,
         check_duplicate: bool,
-    ) -> Result<(), u32> {
+    ) -> Result<(), Refused> {
         let (start, shift) = self.start_cell();
         let (c, qo) = self.locate_from((q.0, self.space.compose(q.1, shift)), start);
         if check_duplicate {
@@ -168,11 +205,14 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 if self.space.coincide(self.lifted(c, i), (q.0, qo)) {
                     self.hint = c;
                     self.hint_shift = self.space.difference(qo, q.1);
-                    return Err(self.tds.cells[c as usize].v[i]);
+                    return Err(Refused::Duplicate(self.tds.cells[c as usize].v[i]));
                 }
             }
         }
         self.find_conflicts(c, qo, q.0);
+        if self.one_sheeted && !self.guaranteed && !self.star_keeps_simplicial() {
+            return Err(Refused::NotSimplicial);
+        }
         self.star_hole(x, q.1);
         Ok(())
     }
@@ -186,22 +226,30 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             return Inserted::New(0);
         }
         let pi = self.points.len() as u32;
-        if self.one_sheeted && !self.guaranteed {
-            // A 1-sheeted triangulation kept without the criterion may not stay valid: go
-            // back to the covering first.
-            self.rebuild_in_covering();
-        }
         if self.one_sheeted {
             self.points.push(p);
             self.vpoint.push(pi);
             self.vcell.push(NONE);
             match self.insert_lifted((p, S::Offset::default()), pi, true) {
-                Ok(()) => Inserted::New(pi),
-                Err(v) => {
+                Ok(()) => {
+                    if !self.guaranteed && self.big_count == 0 {
+                        self.set_guaranteed(true);
+                    }
+                    Inserted::New(pi)
+                }
+                Err(refused) => {
                     self.points.pop();
                     self.vpoint.pop();
                     self.vcell.pop();
-                    Inserted::Duplicate(self.vpoint[v as usize])
+                    match refused {
+                        Refused::Duplicate(v) => Inserted::Duplicate(self.vpoint[v as usize]),
+                        Refused::NotSimplicial => {
+                            // the quotient would stop being a triangulation: continue in
+                            // the covering space
+                            self.rebuild_in_covering();
+                            self.insert(p)
+                        }
+                    }
                 }
             }
         } else {
@@ -211,7 +259,10 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 let x = self.vpoint.len() as u32;
                 self.vpoint.push(pi);
                 self.vcell.push(NONE);
-                if let Err(v) = self.insert_lifted((p, o), x, k == 0) {
+                if let Err(refused) = self.insert_lifted((p, o), x, k == 0) {
+                    let Refused::Duplicate(v) = refused else {
+                        unreachable!("the covering is always a triangulation")
+                    };
                     self.points.pop();
                     self.vpoint.pop();
                     self.vcell.pop();
@@ -220,7 +271,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             }
             if self.big_count == 0 {
                 self.convert_to_one_sheet();
-                self.guaranteed = true;
+                self.set_guaranteed(true);
             }
             Inserted::New(pi)
         }

@@ -60,7 +60,8 @@ pub struct Engine<S: OrbitSpace<N>, const N: usize> {
     /// True while the switch criterion is known to hold, so that further insertions keep a
     /// valid 1-sheeted triangulation.
     pub(crate) guaranteed: bool,
-    /// Covering only: cells whose circumradius is too large for the switch criterion.
+    /// While the criterion is not known to hold (always in the covering): cells whose
+    /// circumradius is too large for it, and their number.
     big: Vec<bool>,
     big_count: usize,
     hint: u32,
@@ -198,26 +199,46 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.space.orient(&self.lifted_cell(c))
     }
 
-    /// Creates a cell, normalizing its offsets, and keeps the covering bookkeeping.
+    /// Creates a cell, normalizing its offsets, and keeps the criterion bookkeeping.
     fn make_cell(&mut self, v: [u32; N], mut off: [S::Offset; N]) -> u32 {
         self.space.normalize(&mut off, self.one_sheeted);
         let id = self.tds.create(Cell::new(v, off));
-        if !self.one_sheeted {
-            let s: LiftedCell<S, N> =
-                std::array::from_fn(|i| (self.points[self.vpoint[v[i] as usize] as usize], off[i]));
-            let big = self.space.circumradius2(&s) >= self.space.criterion_radius2();
-            if self.big.len() <= id as usize {
-                self.big.resize(id as usize + 1, false);
-            }
-            self.big[id as usize] = big;
-            self.big_count += big as usize;
+        if !self.guaranteed {
+            self.track(id);
         }
         id
     }
 
-    /// Deletes a cell and keeps the covering bookkeeping.
+    /// Records whether cell `c` is too large for the switch criterion.
+    fn track(&mut self, c: u32) {
+        let big = self.space.circumradius2(&self.lifted_cell(c)) >= self.space.criterion_radius2();
+        if self.big.len() <= c as usize {
+            self.big.resize(c as usize + 1, false);
+        }
+        self.big[c as usize] = big;
+        self.big_count += big as usize;
+    }
+
+    /// Declares whether the switch criterion is known to hold; when it stops being known,
+    /// every cell is examined so that the count of large cells is exact.
+    fn set_guaranteed(&mut self, holds: bool) {
+        if holds {
+            self.big.clear();
+            self.big_count = 0;
+        } else if self.guaranteed {
+            self.big.clear();
+            self.big_count = 0;
+            let ids: Vec<u32> = self.tds.ids().collect();
+            for c in ids {
+                self.track(c);
+            }
+        }
+        self.guaranteed = holds;
+    }
+
+    /// Deletes a cell and keeps the criterion bookkeeping.
     fn kill_cell(&mut self, c: u32) {
-        if !self.one_sheeted && self.big[c as usize] {
+        if !self.guaranteed && self.big[c as usize] {
             self.big[c as usize] = false;
             self.big_count -= 1;
         }

@@ -1,7 +1,7 @@
 //! Vertex removal in the 1-sheeted triangulation: the star of the vertex is replaced by the
 //! Delaunay triangulation of its link, found by gift wrapping over the star's vertices.
 
-use super::wrap::Owner;
+use super::wrap::{Owner, Wrapped};
 use super::{Candidate, Engine, LiftedCell};
 use crate::space::OrbitSpace;
 use crate::tds::NONE;
@@ -9,14 +9,15 @@ use crate::tds::NONE;
 /// Why a removal was refused.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum RemoveError {
-    /// Without the vertex, the switch criterion would fail: the 1-sheeted quotient is no
-    /// longer guaranteed to be a triangulation.
-    CriterionFails,
+    /// Without the vertex, the 1-sheeted quotient would not be a triangulation (a cycle of
+    /// length ≤ 2 in its 1-skeleton): the covering space is needed.
+    NotSimplicial,
 }
 
 impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
-    /// Removes vertex `v` of a 1-sheeted triangulation that satisfies the criterion, if the
-    /// criterion still holds afterwards; otherwise leaves the triangulation unchanged.
+    /// Removes vertex `v` of a 1-sheeted triangulation. When the new cells break the switch
+    /// criterion, or it already does not hold, the removal goes ahead only if the quotient
+    /// stays a simplicial complex (Theorem 2.2.8); otherwise nothing changes.
     pub(crate) fn remove_vertex(&mut self, v: u32) -> Result<(), RemoveError> {
         debug_assert!(self.one_sheeted);
         // the star, each cell with the shift from its frame to the frame of the first one
@@ -70,19 +71,79 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         }
         let cells = self
             .wrap(seeds, |_, _| hole.clone(), Vec::new())
-            .ok_or(RemoveError::CriterionFails)?;
+            .ok_or(RemoveError::NotSimplicial)?;
         let limit = self.space.criterion_radius2();
-        if cells
+        let breaks = cells
             .iter()
-            .any(|w| self.space.circumradius2(&w.arr) >= limit)
-        {
-            return Err(RemoveError::CriterionFails);
+            .any(|w| self.space.circumradius2(&w.arr) >= limit);
+        if breaks || !self.guaranteed {
+            let star_ids: Vec<u32> = star.iter().map(|s| s.0).collect();
+            if !self.removal_keeps_simplicial(&star_ids, &cells) {
+                return Err(RemoveError::NotSimplicial);
+            }
+            self.set_guaranteed(false);
         }
         for &(c, _, _) in &star {
             self.kill_cell(c);
         }
         self.commit(&cells);
         self.vcell[v as usize] = NONE;
+        if !self.guaranteed && self.big_count == 0 {
+            self.set_guaranteed(true);
+        }
         Ok(())
+    }
+
+    /// True when replacing the cells `star` by `cells` leaves no cycle of length ≤ 2: at every
+    /// vertex of the new cells, the edges (kept old ones and new ones) reach each neighbour
+    /// with a single offset and never the vertex itself.
+    fn removal_keeps_simplicial(
+        &mut self,
+        star: &[u32],
+        cells: &[Wrapped<S::Point, S::Offset, N>],
+    ) -> bool {
+        let mut hole: Vec<u32> = cells.iter().flat_map(|w| w.vids).collect();
+        hole.sort_unstable();
+        hole.dedup();
+        let mut edges: Vec<(u32, S::Offset)> = Vec::new();
+        let mut stack: Vec<u32> = Vec::new();
+        for &a in &hole {
+            edges.clear();
+            for w in cells {
+                if let Some(i) = w.vids.iter().position(|&x| x == a) {
+                    for j in (0..N).filter(|&j| j != i) {
+                        edges.push((w.vids[j], self.space.difference(w.arr[j].1, w.arr[i].1)));
+                    }
+                }
+            }
+            // the old cells around `a` that stay
+            let (mark, _) = self.tds.new_visit();
+            stack.clear();
+            stack.push(self.vcell[a as usize]);
+            self.tds.set_stamp(stack[0], mark);
+            while let Some(c) = stack.pop() {
+                let cell = self.tds.cells[c as usize];
+                let i = cell.index_of(a).expect("the star of a vertex holds it");
+                for k in (0..N).filter(|&k| k != i) {
+                    if !star.contains(&c) {
+                        edges.push((cell.v[k], self.space.difference(cell.off[k], cell.off[i])));
+                    }
+                    let d = cell.n[k];
+                    if self.tds.stamp(d) != mark {
+                        self.tds.set_stamp(d, mark);
+                        stack.push(d);
+                    }
+                }
+            }
+            edges.sort_unstable();
+            if edges.iter().any(|e| e.0 == a)
+                || edges
+                    .windows(2)
+                    .any(|w| w[0].0 == w[1].0 && w[0].1 != w[1].1)
+            {
+                return false;
+            }
+        }
+        true
     }
 }

@@ -273,6 +273,10 @@ impl OrbitSpace<4> for FlatTorus3 {
         self.criterion_r2
     }
 
+    fn single_lift_radius2(&self) -> f64 {
+        4.0 * self.criterion_r2
+    }
+
     fn covering_copies(&self) -> Vec<Offset3> {
         let h = self.covering;
         let mut out = Vec::new();

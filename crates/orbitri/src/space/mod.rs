@@ -48,6 +48,9 @@ pub trait OrbitSpace<const N: usize>: Sync + Send {
     /// Squared circumradius below which every cell is safe for the 1-sheeted quotient
     /// (Corollary 9 of Caroli–Teillaud: `Δ < δ/2`, i.e. radius `< δ/4`), with a safety margin.
     fn criterion_radius2(&self) -> f64;
+    /// Squared radius below which a ball holds at most one lift of any point (`δ/2`), with
+    /// a safety margin: a conflict region made of such balls lifts consistently.
+    fn single_lift_radius2(&self) -> f64;
     /// The offsets of the copies of one point in the initial covering space (one per sheet).
     fn covering_copies(&self) -> Vec<Self::Offset>;
     /// Translates a cell's offsets by a group element of the triangulated space (the covering

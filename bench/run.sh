@@ -1,0 +1,59 @@
+#!/usr/bin/env bash
+# Side-by-side benchmark of `orbitri triangulate` against the CGAL anchor harness
+# (../shared/anchors/cgal): same machine, same points (the harness's generator, seed 1),
+# tools alternating within each repetition. Appends raw key=value lines to bench/out/raw.txt
+# and prints the summary table (bench/summarize.py) that BENCHMARKS.md reproduces.
+#
+# usage: bench/run.sh [REPS] [N ...]        default: 5 reps, N = 100 10000 100000 1000000
+#        CLUSTERED=0 bench/run.sh ...       skip the clustered set
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+anchor_src=${ANCHOR:-$root/../shared/anchors/cgal}
+out=$root/bench/out
+mkdir -p "$out"
+
+if ! [ -x "$out/cgal/cgal_anchor" ]; then
+    if ! dpkg -s libcgal-dev >/dev/null 2>&1; then
+        apt-get update -qq
+        apt-get install -y -qq libcgal-dev libgmp-dev libmpfr-dev libboost-dev >/dev/null
+    fi
+    mkdir -p "$out/cgal"
+    cp "$anchor_src/cgal_anchor.cpp" "$anchor_src/build.sh" "$out/cgal/"
+    (cd "$out/cgal" && ./build.sh)
+fi
+cargo build --release -q -p orbitri-cli --manifest-path "$root/Cargo.toml"
+orb=$root/target/release/orbitri
+cgal=$out/cgal/cgal_anchor
+
+reps=${1:-5}
+shift || true
+ns=${*:-100 10000 100000 1000000}
+raw=$out/raw.txt
+stamp="commit=$(git -C "$root" rev-parse --short HEAD) date=$(date -u +%F)"
+load() { cut -d' ' -f1 /proc/loadavg; }
+
+for n in $ns; do
+    pts=$out/cube_$n.txt
+    [ -f "$pts" ] || "$orb" generate "$n" --seed 1 -o "$pts"
+    for rep in $(seq "$reps"); do
+        line=$("$orb" triangulate "$pts" --box 1 1 1 --stats -o /dev/null 2>&1 >/dev/null)
+        echo "tool=orbitri input=cube N=$n rep=$rep $line load1=$(load) $stamp" | tee -a "$raw"
+        for c in p3dt3 p3dt3f dt3; do
+            echo "tool=cgal input=cube rep=$rep $("$cgal" "$c" "$n" 1) load1=$(load) $stamp" | tee -a "$raw"
+        done
+    done
+done
+
+if [ "${CLUSTERED:-1}" = 1 ]; then
+    # 100 Gaussian clusters (sigma 0.01) of 1000 points each, wrapped into the unit cube
+    n=100000
+    python3 "$root/bench/clustered.py" "$n" "$out/clustered.txt" "$out/clustered_cgal.txt"
+    for rep in $(seq "$reps"); do
+        line=$("$orb" triangulate "$out/clustered.txt" --box 1 1 1 --stats -o /dev/null 2>&1 >/dev/null)
+        echo "tool=orbitri input=clustered N=$n rep=$rep $line load1=$(load) $stamp" | tee -a "$raw"
+        for c in dump3 dump3f; do
+            echo "tool=cgal input=clustered N=$n rep=$rep $("$cgal" "$c" "$out/clustered_cgal.txt" /dev/null) load1=$(load) $stamp" | tee -a "$raw"
+        done
+    done
+fi
+python3 "$root/bench/summarize.py" "$raw"
