@@ -160,7 +160,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     }
 
     /// The point of vertex `v` (the identity once 1-sheeted: no indirection on the hot path).
-    #[inline]
+    #[inline(always)]
     fn point_index(&self, v: u32) -> usize {
         if self.one_sheeted {
             v as usize
@@ -170,7 +170,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     }
 
     /// All lifted vertices of cell `c`.
-    #[inline]
+    #[inline(always)]
     pub fn lifted_cell(&self, c: u32) -> LiftedCell<S, N> {
         let cell = &self.tds.cells[c as usize];
         let mut out = [(self.points[0], cell.off[0]); N];
@@ -181,7 +181,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     }
 
     /// The offset that maps the frame of `d = neighbour(c, i)` onto the frame of `c`.
-    #[inline]
+    #[inline(always)]
     pub fn translation(&self, c: u32, i: usize, d: u32) -> S::Offset {
         let cc = &self.tds.cells[c as usize];
         let dc = &self.tds.cells[d as usize];

@@ -48,7 +48,7 @@ impl<const D: usize> Rows<D> {
 
 /// The lifted difference `(p + t·M) − (p0 + t0·M)` and a bound `B` such that every component
 /// is off by at most `6u·B` and at most `B(1+u)` in magnitude.
-#[inline]
+#[inline(always)]
 pub fn lifted_diff<const D: usize>(
     rows: &Rows<D>,
     p: &[f64; D],
@@ -82,7 +82,7 @@ pub fn lifted_diff<const D: usize>(
 
 /// `p − p0` for two points in the same frame, with the same bound convention as
 /// [`lifted_diff`] (here the error is at most `u·B`).
-#[inline]
+#[inline(always)]
 pub fn plain_diff<const D: usize>(p: &[f64; D], p0: &[f64; D]) -> ([f64; D], f64) {
     let mut d = [0.0; D];
     let mut b = 0.0f64;
@@ -109,7 +109,7 @@ fn det3(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> f64 {
 /// Bound: each of the 6 products of three entries is off by at most `((1+6u)³−1)·B₁B₂B₃(1+u)³
 /// ≤ 18.1u·B₁B₂B₃` from the inputs and by at most `5u·B₁B₂B₃` from its own evaluation (two
 /// products, one difference, one product, two sums); `6·(18.1+5) < 160`.
-#[inline]
+#[inline(always)]
 pub fn orient3(d: &[[f64; 3]; 3], b: [f64; 3]) -> Option<Sign> {
     if !(in_range(b[0]) && in_range(b[1]) && in_range(b[2])) {
         return None;
@@ -135,7 +135,7 @@ pub fn orient3(d: &[[f64; 3]; 3], b: [f64; 3]) -> Option<Sign> {
 /// `3·B_max·ΠB` in magnitude; relative to that, the inputs contribute `3·6u + 15u` (`l_i` is
 /// a sum of three squares, each off by `12u·B²`, plus `3u` to evaluate) and the evaluation
 /// about `10u`; `72·(43u)·B_max·ΠB < 4096u·B_max·ΠB`.
-#[inline]
+#[inline(always)]
 pub fn in_sphere3(d: &[[f64; 3]; 4], b: [f64; 4]) -> Option<Sign> {
     if !b.iter().all(|&x| in_range(x)) {
         return None;

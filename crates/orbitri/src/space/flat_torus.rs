@@ -188,7 +188,7 @@ impl OrbitSpace<4> for FlatTorus3 {
         [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
     }
 
-    #[inline]
+    #[inline(always)]
     fn orient(&self, s: &[L3; 4]) -> Sign {
         let mut d = [[0.0; 3]; 3];
         let mut b = [0.0; 3];
@@ -207,7 +207,7 @@ impl OrbitSpace<4> for FlatTorus3 {
         filter::orient3(&d, b).unwrap_or_else(|| self.orient_exact(s))
     }
 
-    #[inline]
+    #[inline(always)]
     fn in_sphere(&self, s: &[L3; 4], q: L3) -> Sign {
         let mut d = [[0.0; 3]; 4];
         let mut b = [0.0; 4];
