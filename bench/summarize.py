@@ -8,7 +8,13 @@ from collections import defaultdict
 
 
 def parse(line):
-    return dict(kv.split("=", 1) for kv in line.split() if "=" in kv)
+    # first occurrence wins: the harness's own keys come before the tool's output
+    d = {}
+    for kv in line.split():
+        if "=" in kv:
+            k, v = kv.split("=", 1)
+            d.setdefault(k, v)
+    return d
 
 
 def main():

@@ -126,7 +126,14 @@ fn progress_bar(n: usize) -> Option<ProgressBar> {
     Some(bar)
 }
 
-fn build(space: FlatTorus3, pts: &[[f64; 3]]) -> Result<(PeriodicDelaunay3, f64), orbitri::Error> {
+/// What one construction cost: wall time of the build alone, and the process's peak
+/// resident memory read right after it (as the CGAL anchor harness reads it).
+struct Cost {
+    seconds: f64,
+    peak_rss_kb: Option<u64>,
+}
+
+fn build(space: FlatTorus3, pts: &[[f64; 3]]) -> Result<(PeriodicDelaunay3, Cost), orbitri::Error> {
     let bar = progress_bar(pts.len());
     let start = Instant::now();
     let tri = PeriodicDelaunay3::build_with(space, pts, BuildOptions::default(), |k| {
@@ -134,23 +141,27 @@ fn build(space: FlatTorus3, pts: &[[f64; 3]]) -> Result<(PeriodicDelaunay3, f64)
             b.set_position(k as u64);
         }
     })?;
-    let secs = start.elapsed().as_secs_f64();
+    let cost = Cost {
+        seconds: start.elapsed().as_secs_f64(),
+        peak_rss_kb: rss::peak_kb(),
+    };
     if let Some(b) = bar {
         b.finish_and_clear();
     }
-    Ok((tri, secs))
+    Ok((tri, cost))
 }
 
-fn stats_line(tri: &PeriodicDelaunay3, input: usize, secs: f64) -> String {
+fn stats_line(tri: &PeriodicDelaunay3, input: usize, cost: &Cost) -> String {
     format!(
-        "input={input} vertices={} cells={} sheets={} duplicates={} wrapped={} dummies={} build_seconds={secs:.6} peak_rss_kb={}",
+        "input={input} vertices={} cells={} sheets={} duplicates={} wrapped={} dummies={} build_seconds={:.6} peak_rss_kb={}",
         tri.number_of_vertices(),
         tri.number_of_cells(),
         tri.sheets(),
         tri.duplicates(),
         tri.wrapped(),
         tri.used_dummy_points(),
-        rss::peak_kb().map_or("unknown".to_string(), |k| k.to_string())
+        cost.seconds,
+        cost.peak_rss_kb.map_or("unknown".to_string(), |k| k.to_string())
     )
 }
 
@@ -169,7 +180,7 @@ fn writer(path: &Option<PathBuf>) -> Result<Box<dyn Write>, CliError> {
 fn triangulate(input: PathBuf, domain: Domain, out: Output) -> Result<(), CliError> {
     let space = space(&domain)?;
     let pts: Vec<[f64; 3]> = orbitri::io::read_points(&input)?;
-    let (tri, secs) = build(space, &pts)?;
+    let (tri, cost) = build(space, &pts)?;
     let path = out
         .output
         .clone()
@@ -182,7 +193,7 @@ fn triangulate(input: PathBuf, domain: Domain, out: Output) -> Result<(), CliErr
     res.and_then(|_| w.flush())
         .map_err(|source| CliError::Write { path, source })?;
     if out.stats {
-        eprintln!("{}", stats_line(&tri, pts.len(), secs));
+        eprintln!("{}", stats_line(&tri, pts.len(), &cost));
     }
     Ok(())
 }
@@ -198,17 +209,17 @@ fn demo(n: usize, seed: u64) -> Result<(), CliError> {
         let _ = writeln!(out, "{s}");
     };
     let pts = uniform(n, seed);
-    let (tri, secs) = build(FlatTorus3::cuboid([1.0; 3])?, &pts)?;
+    let (tri, cost) = build(FlatTorus3::cuboid([1.0; 3])?, &pts)?;
     say(
         &mut out,
         format!("uniform random points in the unit cube (seed {seed}):"),
     );
-    say(&mut out, format!("  {}", stats_line(&tri, n, secs)));
+    say(&mut out, format!("  {}", stats_line(&tri, n, &cost)));
     say(
         &mut out,
         format!(
             "  {:.2} µs per point; Euler check E = V + C: {}",
-            secs * 1e6 / n as f64,
+            cost.seconds * 1e6 / n as f64,
             tri.edges(orbitri::Copies::Unique).len()
                 == tri.number_of_vertices() + tri.number_of_cells()
         ),
@@ -242,12 +253,15 @@ fn demo(n: usize, seed: u64) -> Result<(), CliError> {
             }
         }
     }
-    let (tri, secs) = build(FlatTorus3::cuboid([0.6; 3])?, &fcc)?;
+    let (tri, cost) = build(FlatTorus3::cuboid([0.6; 3])?, &fcc)?;
     say(
         &mut out,
         "FCC crystal, 864 points, all octahedral holes cospherical:".to_string(),
     );
-    say(&mut out, format!("  {}", stats_line(&tri, fcc.len(), secs)));
+    say(
+        &mut out,
+        format!("  {}", stats_line(&tri, fcc.len(), &cost)),
+    );
     tri.is_valid().map_err(|e| CliError::Check(e.to_string()))?;
     say(
         &mut out,

@@ -307,17 +307,19 @@ impl PeriodicDelaunay3 {
         }
     }
 
+    /// Every stored cell, lazily (for writers of large triangulations).
+    pub fn stored_cells(&self) -> impl Iterator<Item = CellView> + '_ {
+        self.engine.cell_ids().map(|c| self.view(c))
+    }
+
     /// The cells with input ids and offsets: every stored cell, or one per orbit.
     pub fn cells(&self, copies: Copies) -> Vec<CellView> {
-        let stored: Vec<u32> = self.engine.cell_ids().collect();
         if copies == Copies::Stored || self.is_one_sheeted() {
-            return stored.into_iter().map(|c| self.view(c)).collect();
+            return self.stored_cells().collect();
         }
         let mut seen = HashSet::new();
-        stored
-            .into_iter()
-            .filter(|&c| seen.insert(canonical(&self.view(c).vertices, &self.view(c).offsets)))
-            .map(|c| self.view(c))
+        self.stored_cells()
+            .filter(|c| seen.insert(canonical(&c.vertices, &c.offsets)))
             .collect()
     }
 

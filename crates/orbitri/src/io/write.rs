@@ -2,21 +2,20 @@
 
 use std::io::Write;
 
-use crate::periodic3::{Copies, PeriodicDelaunay3};
+use crate::periodic3::PeriodicDelaunay3;
 
 /// The `cells` format: `SHEETS V C`, then per stored cell the 4 input ids and the 4 offsets
 /// (3 integers each, lattice units), positively oriented. `V` counts distinct points, `C`
 /// the cell lines that follow (in a covering space: every stored copy).
 pub fn write_cells(w: &mut impl Write, tri: &PeriodicDelaunay3) -> std::io::Result<()> {
-    let cells = tri.cells(Copies::Stored);
     writeln!(
         w,
         "{} {} {}",
         tri.sheets(),
         tri.number_of_vertices(),
-        cells.len()
+        tri.number_of_cells()
     )?;
-    for c in &cells {
+    for c in tri.stored_cells() {
         let v = c.vertices;
         let o = c.offsets;
         writeln!(
@@ -49,57 +48,45 @@ fn json_f64(x: f64) -> String {
 }
 
 /// JSON: `{"dimension", "sheets", "lattice", "points" (wrapped, input order),
-/// "first_occurrence", "cells", "offsets"}`.
+/// "first_occurrence", "cells", "offsets"}`, written as it is produced.
 pub fn write_json(w: &mut impl Write, tri: &PeriodicDelaunay3) -> std::io::Result<()> {
-    let lattice = tri.space().lattice().vectors();
     let row = |r: &[f64; 3]| format!("[{},{},{}]", json_f64(r[0]), json_f64(r[1]), json_f64(r[2]));
     write!(
         w,
         "{{\"dimension\":3,\"sheets\":{},\"lattice\":[",
         tri.sheets()
     )?;
-    write!(
+    write_list(w, tri.space().lattice().vectors().iter().map(row))?;
+    write!(w, "],\"points\":[")?;
+    write_list(
         w,
-        "{}]",
-        lattice.iter().map(row).collect::<Vec<_>>().join(",")
+        (0..tri.number_of_input_points())
+            .map(|i| row(&tri.points()[tri.vertex_of_input(i) as usize])),
     )?;
-    let first = tri.first_occurrences();
-    let pts: Vec<String> = (0..tri.number_of_input_points())
-        .map(|i| row(&tri.points()[tri.vertex_of_input(i) as usize]))
-        .collect();
-    write!(w, ",\"points\":[{}]", pts.join(","))?;
-    write!(
+    write!(w, "],\"first_occurrence\":[")?;
+    write_list(w, tri.first_occurrences().iter().map(|x| x.to_string()))?;
+    write!(w, "],\"cells\":[")?;
+    write_list(
         w,
-        ",\"first_occurrence\":[{}]",
-        first
-            .iter()
-            .map(|x| x.to_string())
-            .collect::<Vec<_>>()
-            .join(",")
+        tri.stored_cells()
+            .map(|c| format!("{:?}", c.vertices).replace(' ', "")),
     )?;
-    let cells = tri.cells(Copies::Stored);
-    let cv: Vec<String> = cells
-        .iter()
-        .map(|c| {
-            format!(
-                "[{},{},{},{}]",
-                c.vertices[0], c.vertices[1], c.vertices[2], c.vertices[3]
-            )
-        })
-        .collect();
-    write!(w, ",\"cells\":[{}]", cv.join(","))?;
-    let co: Vec<String> = cells
-        .iter()
-        .map(|c| {
-            format!(
-                "[{}]",
-                c.offsets
-                    .iter()
-                    .map(|o| format!("[{},{},{}]", o[0], o[1], o[2]))
-                    .collect::<Vec<_>>()
-                    .join(",")
-            )
-        })
-        .collect();
-    writeln!(w, ",\"offsets\":[{}]}}", co.join(","))
+    write!(w, "],\"offsets\":[")?;
+    write_list(
+        w,
+        tri.stored_cells()
+            .map(|c| format!("{:?}", c.offsets).replace(' ', "")),
+    )?;
+    writeln!(w, "]}}")
+}
+
+/// Writes the items separated by commas.
+fn write_list(w: &mut impl Write, items: impl Iterator<Item = String>) -> std::io::Result<()> {
+    for (k, item) in items.enumerate() {
+        if k > 0 {
+            w.write_all(b",")?;
+        }
+        w.write_all(item.as_bytes())?;
+    }
+    Ok(())
 }
