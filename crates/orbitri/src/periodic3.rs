@@ -129,6 +129,9 @@ impl PeriodicDelaunay3 {
         };
         let mut tri = PeriodicDelaunay3::new(space.clone());
         tri.wrapped = wrapped;
+        // a 3D Delaunay triangulation of uniform points has about 6.77 cells per vertex
+        tri.engine
+            .reserve(points.len() + 128, points.len() * 27 / 4 + 4096);
         if points.len() >= opts.dummy_threshold
             && tri.build_from_dummies(&wrapped_pts, &order, &progress)
         {

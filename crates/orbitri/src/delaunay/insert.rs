@@ -24,6 +24,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         let mut prev = NONE;
         'walk: loop {
             let r = self.rng.below(N);
+            self.tds.prefetch_neighbours(c);
             let mut s = self.lifted_cell(c);
             for k in 0..N {
                 let i = (r + k) % N;
@@ -75,6 +76,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                     let qd = self.space.difference(qo, self.translation(c, i, d));
                     if self.space.in_sphere(&self.lifted_cell(d), (p, qd)) == Sign::Positive {
                         self.tds.set_stamp(d, inside);
+                        self.tds.prefetch_neighbours(d);
                         scratch.conflict.push((d, qd));
                         continue;
                     }

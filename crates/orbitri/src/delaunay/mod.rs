@@ -93,6 +93,14 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         }
     }
 
+    /// Reserves room for about `cells` cells and `points` points (bulk construction).
+    pub fn reserve(&mut self, points: usize, cells: usize) {
+        self.points.reserve(points);
+        self.vpoint.reserve(points);
+        self.vcell.reserve(points);
+        self.tds.reserve(cells);
+    }
+
     /// The orbit space.
     pub fn space(&self) -> &S {
         &self.space
