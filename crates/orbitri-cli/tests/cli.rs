@@ -161,61 +161,72 @@ fn a_duplicate_takes_its_first_occurrence_id() {
 #[test]
 fn bad_input_gets_a_clear_error_and_exit_code_2() {
     let dir = tempfile::tempdir().unwrap();
-    let cases: Vec<(PathBuf, Vec<&str>, &str)> = vec![
+    let cube = "--box 1 1 1";
+    let cases = [
         (
-            write(dir.path(), "nan.txt", "0 0 0\n0.5 nan 0.5\n"),
-            vec!["--box", "1", "1", "1"],
+            "nan.txt",
+            "0 0 0\n0.5 nan 0.5\n",
+            cube,
             "nan.txt:2: coordinate 1 is NaN",
         ),
         (
-            write(dir.path(), "inf.txt", "0 0 0\n\n0.5 0.5 -inf\n"),
-            vec!["--box", "1", "1", "1"],
+            "inf.txt",
+            "0 0 0\n\n0.5 0.5 -inf\n",
+            cube,
             "inf.txt:3: coordinate 2 is -inf",
         ),
         (
-            write(dir.path(), "cols.txt", "0 0 0\n0.5 0.5\n"),
-            vec!["--box", "1", "1", "1"],
+            "cols.txt",
+            "0 0 0\n0.5 0.5\n",
+            cube,
             "cols.txt:2: expected 3 coordinates, found 2",
         ),
         (
-            write(dir.path(), "word.txt", "0 0 zero\n"),
-            vec!["--box", "1", "1", "1"],
+            "word.txt",
+            "0 0 zero\n",
+            cube,
             "word.txt:1: coordinate 2 'zero' is not a number",
         ),
         (
-            write(dir.path(), "empty.txt", "# nothing\n\n"),
-            vec!["--box", "1", "1", "1"],
+            "empty.txt",
+            "# nothing\n\n",
+            cube,
             "the file holds no points",
         ),
         (
-            write(dir.path(), "ok.txt", "0.5 0.5 0.5\n"),
-            vec!["--box", "1", "0", "1"],
+            "a.txt",
+            "0.5 0.5 0.5\n",
+            "--box 1 0 1",
             "invalid box: length 1 is 0",
         ),
         (
-            write(dir.path(), "ok2.txt", "0.5 0.5 0.5\n"),
-            vec!["--box", "1", "-2", "1"],
+            "b.txt",
+            "0.5 0.5 0.5\n",
+            "--box 1 -2 1",
             "invalid box: length 1 is -2",
         ),
         (
-            write(dir.path(), "ok3.txt", "0.5 0.5 0.5\n"),
-            vec!["--lattice", "1", "0", "0", "0", "1", "0", "1", "1", "0"],
+            "c.txt",
+            "0.5 0.5 0.5\n",
+            "--lattice 1 0 0 0 1 0 1 1 0",
             "singular lattice",
         ),
         (
-            write(dir.path(), "ok4.txt", "0.5 0.5 0.5\n"),
-            vec!["--lattice", "1", "0", "0", "30", "0.1", "0", "0", "0", "1"],
+            "d.txt",
+            "0.5 0.5 0.5\n",
+            "--lattice 1 0 0 30 0.1 0 0 0 1",
             "lattice too skewed",
         ),
-        (
-            dir.path().join("missing.txt"),
-            vec!["--box", "1", "1", "1"],
-            "missing.txt: No such file",
-        ),
+        ("missing.txt", "", cube, "missing.txt: No such file"),
     ];
-    for (path, dom, msg) in cases {
+    for (name, text, domain, msg) in cases {
+        let path = if text.is_empty() {
+            dir.path().join(name)
+        } else {
+            write(dir.path(), name, text)
+        };
         let mut args = vec!["triangulate", path.to_str().unwrap()];
-        args.extend(dom);
+        args.extend(domain.split(' '));
         let o = orbitri(&args);
         assert_eq!(o.status.code(), Some(2), "{args:?}");
         assert!(stderr(&o).contains(msg), "{args:?}: {}", stderr(&o));

@@ -2,15 +2,13 @@
 //! consistent offsets, vertex pointers, Euler characteristic) and geometry (positive
 //! orientation, local Delaunay property, exactly).
 
-use std::collections::HashSet;
-
 use super::Engine;
 use crate::predicates::Sign;
 use crate::space::OrbitSpace;
 use crate::tds::NONE;
 
-/// A face as sorted (vertex, offset) pairs.
-type FaceKey<O> = Vec<(u32, O)>;
+/// A face as sorted (vertex, offset) pairs, padded with `NONE`.
+type FaceKey<O, const N: usize> = [(u32, O); N];
 
 /// Why a triangulation is invalid.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
@@ -29,6 +27,9 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             };
         }
         for c in self.tds.ids() {
+            if self.orientation(c) != Sign::Positive {
+                return bad(format!("cell {c} is not positively oriented"));
+            }
             let cell = &self.tds.cells[c as usize];
             for i in 0..N {
                 if (i + 1..N).any(|j| cell.v[i] == cell.v[j]) {
@@ -69,9 +70,6 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                     ));
                 }
             }
-            if self.orientation(c) != Sign::Positive {
-                return bad(format!("cell {c} is not positively oriented"));
-            }
         }
         for (v, &c) in self.vcell.iter().enumerate() {
             if c == NONE
@@ -81,53 +79,114 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 return bad(format!("vertex {v} has no incident cell"));
             }
         }
-        // Euler characteristic of a closed 3-manifold (or of a torus) is 0
-        let mut faces: Vec<HashSet<FaceKey<S::Offset>>> = vec![HashSet::new(); N];
+        // Euler characteristic of a closed 3-manifold (or of a torus) is 0. Faces are keyed
+        // by fixed-size arrays (unused slots NONE), sorted and deduplicated per dimension.
+        let mut faces: Vec<Vec<FaceKey<S::Offset, N>>> = vec![Vec::new(); N];
         for c in self.tds.ids() {
             let cell = &self.tds.cells[c as usize];
             for mask in 1u32..(1 << N) {
-                let members: Vec<usize> = (0..N).filter(|i| mask >> i & 1 == 1).collect();
-                let mut face: Vec<(u32, S::Offset)> = members
-                    .iter()
-                    .map(|&i| {
-                        (
-                            cell.v[i],
-                            self.space.difference(cell.off[i], cell.off[members[0]]),
-                        )
-                    })
-                    .collect();
+                let first = mask.trailing_zeros() as usize;
+                let mut face = [(NONE, S::Offset::default()); N];
+                let mut k = 0;
+                for i in (0..N).filter(|i| mask >> i & 1 == 1) {
+                    // covering: vertex ids are unique per copy, offsets are implied
+                    let rel = if self.one_sheeted {
+                        self.space.difference(cell.off[i], cell.off[first])
+                    } else {
+                        S::Offset::default()
+                    };
+                    face[k] = (cell.v[i], rel);
+                    k += 1;
+                }
                 // translate so that the smallest vertex sits at offset 0
-                face.sort_unstable();
+                face[..k].sort_unstable();
                 let base = face[0].1;
-                for f in face.iter_mut() {
+                for f in face[..k].iter_mut() {
                     f.1 = self.space.difference(f.1, base);
                 }
-                if self.one_sheeted {
-                    faces[members.len() - 1].insert(face);
-                } else {
-                    // covering: vertex ids are unique per copy, offsets are implied
-                    faces[members.len() - 1]
-                        .insert(face.iter().map(|f| (f.0, S::Offset::default())).collect());
-                }
+                faces[k - 1].push(face);
             }
         }
-        let euler: i64 = faces
-            .iter()
-            .enumerate()
-            .map(|(k, f)| {
-                if k % 2 == 0 {
-                    f.len() as i64
-                } else {
-                    -(f.len() as i64)
-                }
-            })
-            .sum();
+        let mut euler = 0i64;
+        let mut counts = Vec::with_capacity(N);
+        for (k, f) in faces.iter_mut().enumerate() {
+            f.sort_unstable();
+            f.dedup();
+            counts.push(f.len());
+            euler += if k % 2 == 0 {
+                f.len() as i64
+            } else {
+                -(f.len() as i64)
+            };
+        }
         if euler != 0 {
             return bad(format!(
                 "Euler characteristic {euler}, expected 0 (counts {:?})",
-                faces.iter().map(|f| f.len()).collect::<Vec<_>>()
+                counts
             ));
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::sort::SplitMix;
+    use crate::space::FlatTorus3;
+    use crate::Engine;
+
+    fn engine() -> Engine<FlatTorus3, 4> {
+        let mut e = Engine::new(FlatTorus3::cuboid([1.0; 3]).unwrap());
+        let mut r = SplitMix::new(3);
+        for _ in 0..400 {
+            e.insert([r.unit(), r.unit(), r.unit()]);
+        }
+        assert!(e.is_one_sheeted());
+        e.is_valid().unwrap();
+        e
+    }
+
+    #[test]
+    fn detects_a_negatively_oriented_cell() {
+        let mut e = engine();
+        let c = e.tds.ids().next().unwrap();
+        let cell = &mut e.tds.cells[c as usize];
+        cell.v.swap(0, 1);
+        cell.n.swap(0, 1);
+        cell.off.swap(0, 1);
+        let msg = e.is_valid().unwrap_err().0;
+        assert!(msg.contains("not positively oriented"), "{msg}");
+    }
+
+    #[test]
+    fn detects_broken_neighbours_and_offsets() {
+        let mut e = engine();
+        let c = e.tds.ids().next().unwrap();
+        let d = e.tds.cells[c as usize].n[0];
+        let j = e.tds.cells[d as usize].mirror(c).unwrap();
+        e.tds.cells[d as usize].n[j] = e.tds.cells[d as usize].n[(j + 1) % 4];
+        assert!(e.is_valid().is_err());
+
+        let mut e = engine();
+        let c = e
+            .tds
+            .ids()
+            .find(|&c| e.tds.cells[c as usize].off.iter().all(|o| *o == [0; 3]))
+            .unwrap();
+        e.tds.cells[c as usize].off[2] = [1, 0, 0];
+        assert!(e.is_valid().is_err());
+    }
+
+    #[test]
+    fn detects_a_non_delaunay_cell() {
+        let mut e = engine();
+        // moving a point off its place breaks the empty-sphere property somewhere nearby
+        let p = e.points[7];
+        e.points[7] = [(p[0] + 0.05) % 1.0, p[1], p[2]];
+        let msg = e.is_valid().unwrap_err().0;
+        assert!(
+            msg.contains("locally Delaunay") || msg.contains("oriented"),
+            "{msg}"
+        );
     }
 }

@@ -402,6 +402,18 @@ mod tests {
         FlatTorus3::cuboid([1.0; 3]).unwrap()
     }
 
+    /// The corner of a cube of side 0.5 at the origin: its circumsphere passes through all
+    /// eight corners of that cube.
+    fn corner_tetrahedron() -> [L3; 4] {
+        let z = [0i8; 3];
+        [
+            ([0.0, 0.0, 0.0], z),
+            ([0.5, 0.0, 0.0], z),
+            ([0.0, 0.5, 0.0], z),
+            ([0.0, 0.0, 0.5], z),
+        ]
+    }
+
     #[test]
     fn orientation_and_in_sphere_conventions() {
         let t = unit();
@@ -470,12 +482,7 @@ mod tests {
         let t = unit();
         let z = [0i8; 3];
         // corners of a cube: all cospherical
-        let s = [
-            ([0.0, 0.0, 0.0], z),
-            ([0.5, 0.0, 0.0], z),
-            ([0.0, 0.5, 0.0], z),
-            ([0.0, 0.0, 0.5], z),
-        ];
+        let s = corner_tetrahedron();
         let q = ([0.5, 0.5, 0.5], z);
         let base = t.in_sphere(&s, q);
         assert_ne!(base, Sign::Zero);
@@ -494,13 +501,7 @@ mod tests {
     #[test]
     fn circumradius_and_normalize() {
         let t = unit();
-        let z = [0i8; 3];
-        let s = [
-            ([0.0, 0.0, 0.0], z),
-            ([0.5, 0.0, 0.0], z),
-            ([0.0, 0.5, 0.0], z),
-            ([0.0, 0.0, 0.5], z),
-        ];
+        let s = corner_tetrahedron();
         assert!((t.circumradius2(&s) - 0.1875).abs() < 1e-15);
         assert!((t.volume(&s) - 0.125 / 6.0).abs() < 1e-15);
         let mut off = [[1i8, 2, 0], [1, 1, 0], [2, 1, 1], [1, 1, 0]];
