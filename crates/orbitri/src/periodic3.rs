@@ -368,24 +368,19 @@ impl PeriodicDelaunay3 {
     }
 
     /// The neighbours of input point `i`: (input id, offset of the neighbour relative to
-    /// the point), one entry per Delaunay edge at the point.
+    /// the point), one entry per Delaunay edge at the point, from the point's star.
     pub fn vertex_neighbors(&self, i: usize) -> Vec<(u32, Offset)> {
-        let me = self.point_input[self.input_point[i] as usize];
-        let mut out: Vec<(u32, Offset)> = self
-            .edges(Copies::Unique)
-            .into_iter()
-            .filter_map(|e| {
-                let s = self.space();
-                if e.vertices[0] == me && e.vertices[1] != me {
-                    Some((e.vertices[1], s.difference(e.offsets[1], e.offsets[0])))
-                } else if e.vertices[1] == me && e.vertices[0] != me {
-                    Some((e.vertices[0], s.difference(e.offsets[0], e.offsets[1])))
-                } else {
-                    None
-                }
-            })
-            .collect();
+        let v = self.engine.vertex_of_point(self.input_point[i]);
+        let mut out: Vec<(u32, Offset)> = Vec::new();
+        for (c, k, _) in self.engine.star(v) {
+            let cell = self.engine.cell(c);
+            for j in (0..4).filter(|&j| j != k) {
+                let id = self.point_input[self.engine.point_of(cell.v[j]) as usize];
+                out.push((id, self.space().difference(cell.off[j], cell.off[k])));
+            }
+        }
         out.sort_unstable();
+        out.dedup();
         out
     }
 

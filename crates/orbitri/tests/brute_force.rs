@@ -322,6 +322,9 @@ fn access_api() {
         small.cells(Copies::Stored).len(),
         27 * small.cells(Copies::Unique).len()
     );
+    // neighbours from a vertex's star agree with the unique edges, also in the covering
+    let degrees: usize = (0..3).map(|i| small.vertex_neighbors(i).len()).sum();
+    assert_eq!(degrees, 2 * small.edges(Copies::Unique).len());
 }
 
 #[test]

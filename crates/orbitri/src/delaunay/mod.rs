@@ -202,6 +202,43 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.space.difference(cc.off[k], dc.off[j])
     }
 
+    /// The cells incident to vertex `v`: (cell, index of `v` in it, shift from the cell's
+    /// frame to the frame of the first cell, so that the star lifts as one piece).
+    pub fn star(&self, v: u32) -> Vec<(u32, usize, S::Offset)> {
+        let c0 = self.vcell[v as usize];
+        let i0 = self.tds.cells[c0 as usize]
+            .index_of(v)
+            .expect("vcell holds its vertex");
+        let mut star = vec![(c0, i0, S::Offset::default())];
+        let mut next = 0;
+        while next < star.len() {
+            let (c, i, shift) = star[next];
+            for k in (0..N).filter(|&k| k != i) {
+                let d = self.tds.cells[c as usize].n[k];
+                if star.iter().any(|s| s.0 == d) {
+                    continue;
+                }
+                let t = self.space.compose(self.translation(c, k, d), shift);
+                let j = self.tds.cells[d as usize]
+                    .index_of(v)
+                    .expect("a neighbour through a facet holding v holds v");
+                star.push((d, j, t));
+            }
+            next += 1;
+        }
+        star
+    }
+
+    /// A vertex of point `p`: the point itself once 1-sheeted, its copy on sheet 0 (offset
+    /// zero) in the covering.
+    pub fn vertex_of_point(&self, p: u32) -> u32 {
+        if self.one_sheeted {
+            p
+        } else {
+            p * self.space.sheets() as u32 + self.space.sheet_of(S::Offset::default()) as u32
+        }
+    }
+
     /// Exact orientation of a stored cell.
     pub fn orientation(&self, c: u32) -> Sign {
         self.space.orient(&self.lifted_cell(c))

@@ -20,35 +20,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// stays a simplicial complex (Theorem 2.2.8); otherwise nothing changes.
     pub(crate) fn remove_vertex(&mut self, v: u32) -> Result<(), RemoveError> {
         debug_assert!(self.one_sheeted);
-        // the star, each cell with the shift from its frame to the frame of the first one
-        let c0 = self.vcell[v as usize];
-        let mut star: Vec<(u32, usize, S::Offset)> = vec![(
-            c0,
-            self.tds.cells[c0 as usize].index_of(v).unwrap(),
-            S::Offset::default(),
-        )];
-        let (mark, _) = self.tds.new_visit();
-        self.tds.set_stamp(c0, mark);
-        let mut next = 0;
-        while next < star.len() {
-            let (c, i, shift) = star[next];
-            for k in 0..N {
-                if k == i {
-                    continue;
-                }
-                let d = self.tds.cells[c as usize].n[k];
-                if self.tds.stamp(d) == mark {
-                    continue;
-                }
-                self.tds.set_stamp(d, mark);
-                let t = self.space.compose(self.translation(c, k, d), shift);
-                let j = self.tds.cells[d as usize]
-                    .index_of(v)
-                    .expect("a neighbour through a facet holding v holds v");
-                star.push((d, j, t));
-            }
-            next += 1;
-        }
+        let star = self.star(v);
         let shifted = |e: &Self, c: u32, shift: S::Offset| -> LiftedCell<S, N> {
             e.lifted_cell(c)
                 .map(|(p, o)| (p, e.space.compose(o, shift)))
