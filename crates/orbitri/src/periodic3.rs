@@ -326,45 +326,72 @@ impl PeriodicDelaunay3 {
             .collect()
     }
 
-    /// Faces with `k` vertices (2: edges, 3: facets), each once (canonical form).
-    fn faces(&self, k: usize, copies: Copies) -> Vec<Simplex> {
-        let mut out: HashSet<Simplex> = HashSet::new();
-        for c in self.engine.cell_ids() {
-            let cell = self.engine.cell(c);
-            for mask in 0u32..16 {
-                if mask.count_ones() as usize != k {
-                    continue;
-                }
-                let idx: Vec<usize> = (0..4).filter(|i| mask >> i & 1 == 1).collect();
-                let (v, o): (Vec<u32>, Vec<Offset>) = match copies {
-                    Copies::Unique => idx
-                        .iter()
-                        .map(|&i| {
-                            (
-                                self.point_input[self.engine.point_of(cell.v[i]) as usize],
-                                cell.off[i],
-                            )
-                        })
-                        .unzip(),
-                    Copies::Stored => idx.iter().map(|&i| (cell.v[i], cell.off[i])).unzip(),
-                };
-                let (vertices, offsets) = canonical(&v, &o);
-                out.insert(Simplex { vertices, offsets });
-            }
-        }
-        let mut v: Vec<Simplex> = out.into_iter().collect();
-        v.sort_unstable();
-        v
+    /// A face of a stored cell (the slots in `idx`): its vertices as input ids (`Unique`)
+    /// or stored vertex ids (`Stored`), in canonical form.
+    fn face(&self, c: u32, idx: &[usize], copies: Copies) -> Simplex {
+        let cell = self.engine.cell(c);
+        let id = |x: u32| match copies {
+            Copies::Unique => self.point_input[self.engine.point_of(x) as usize],
+            Copies::Stored => x,
+        };
+        let v: Vec<u32> = idx.iter().map(|&i| id(cell.v[i])).collect();
+        let o: Vec<Offset> = idx.iter().map(|&i| cell.off[i]).collect();
+        let (vertices, offsets) = canonical(&v, &o);
+        Simplex { vertices, offsets }
     }
 
-    /// The edges (input ids, offsets), each once; `Stored` lists covering copies by vertex id.
+    /// In a covering space, one copy per orbit of faces (canonical forms deduplicated).
+    fn unique_in_covering(&self, faces: impl Iterator<Item = Simplex>) -> Vec<Simplex> {
+        let mut out: Vec<Simplex> = faces.collect::<HashSet<_>>().into_iter().collect();
+        out.sort_unstable();
+        out
+    }
+
+    /// The edges (input ids, offsets), each once; `Stored` lists covering copies by vertex
+    /// id. Found from each vertex's star, towards the larger vertex id.
     pub fn edges(&self, copies: Copies) -> Vec<Simplex> {
-        self.faces(2, copies)
+        let per_vertex = (0..self.engine.number_of_vertices() as u32).flat_map(|v| {
+            let mut around: Vec<(u32, Offset, u32, usize, usize)> = Vec::new();
+            for (c, k, _) in self.engine.star(v) {
+                let cell = self.engine.cell(c);
+                for j in (0..4).filter(|&j| cell.v[j] > v) {
+                    around.push((
+                        cell.v[j],
+                        self.space().difference(cell.off[j], cell.off[k]),
+                        c,
+                        k,
+                        j,
+                    ));
+                }
+            }
+            around.sort_unstable_by_key(|a| (a.0, a.1));
+            around.dedup_by_key(|a| (a.0, a.1));
+            around.into_iter().map(move |(_, _, c, k, j)| (c, k, j))
+        });
+        if copies == Copies::Unique && !self.is_one_sheeted() {
+            return self
+                .unique_in_covering(per_vertex.map(|(c, k, j)| self.face(c, &[k, j], copies)));
+        }
+        per_vertex
+            .map(|(c, k, j)| self.face(c, &[k, j], copies))
+            .collect()
     }
 
-    /// The facets, each once; `Stored` lists covering copies by vertex id.
+    /// The facets, each once (from the cell with the smaller id); `Stored` lists covering
+    /// copies by vertex id.
     pub fn facets(&self, copies: Copies) -> Vec<Simplex> {
-        self.faces(3, copies)
+        let all = self.engine.cell_ids().flat_map(|c| {
+            let n = self.engine.cell(c).n;
+            (0..4).filter(move |&i| c < n[i]).map(move |i| (c, i))
+        });
+        let face = |(c, i): (u32, usize)| {
+            let idx: Vec<usize> = (0..4).filter(|&k| k != i).collect();
+            self.face(c, &idx, copies)
+        };
+        if copies == Copies::Unique && !self.is_one_sheeted() {
+            return self.unique_in_covering(all.map(face));
+        }
+        all.map(face).collect()
     }
 
     /// The neighbours of input point `i`: (input id, offset of the neighbour relative to

@@ -7,9 +7,6 @@ use crate::predicates::Sign;
 use crate::space::OrbitSpace;
 use crate::tds::NONE;
 
-/// A face as sorted (vertex, offset) pairs, padded with `NONE`.
-type FaceKey<O, const N: usize> = [(u32, O); N];
-
 /// Why a triangulation is invalid.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 #[error("invalid triangulation: {0}")]
@@ -79,49 +76,34 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 return bad(format!("vertex {v} has no incident cell"));
             }
         }
-        // Euler characteristic of a closed 3-manifold (or of a torus) is 0. Faces are keyed
-        // by fixed-size arrays (unused slots NONE), sorted and deduplicated per dimension.
-        let mut faces: Vec<Vec<FaceKey<S::Offset, N>>> = vec![Vec::new(); N];
-        for c in self.tds.ids() {
-            let cell = &self.tds.cells[c as usize];
-            for mask in 1u32..(1 << N) {
-                let first = mask.trailing_zeros() as usize;
-                let mut face = [(NONE, S::Offset::default()); N];
-                let mut k = 0;
-                for i in (0..N).filter(|i| mask >> i & 1 == 1) {
+        // Euler characteristic 0 (torus, closed flat 3-manifold). Every facet is shared by
+        // two cells (checked above), so F = 2C in 3D and the faces are the cells in 2D: in
+        // both, χ = V − E + C. Edges are counted from each vertex's star, towards larger ids.
+        let mut edges = 0usize;
+        let mut around: Vec<(u32, S::Offset)> = Vec::new();
+        for v in 0..self.vcell.len() as u32 {
+            around.clear();
+            for (c, k, _) in self.star(v) {
+                let cell = &self.tds.cells[c as usize];
+                for j in (0..N).filter(|&j| j != k && cell.v[j] > v) {
                     // covering: vertex ids are unique per copy, offsets are implied
                     let rel = if self.one_sheeted {
-                        self.space.difference(cell.off[i], cell.off[first])
+                        self.space.difference(cell.off[j], cell.off[k])
                     } else {
                         S::Offset::default()
                     };
-                    face[k] = (cell.v[i], rel);
-                    k += 1;
+                    around.push((cell.v[j], rel));
                 }
-                // translate so that the smallest vertex sits at offset 0
-                face[..k].sort_unstable();
-                let base = face[0].1;
-                for f in face[..k].iter_mut() {
-                    f.1 = self.space.difference(f.1, base);
-                }
-                faces[k - 1].push(face);
             }
+            around.sort_unstable();
+            around.dedup();
+            edges += around.len();
         }
-        let mut euler = 0i64;
-        let mut counts = Vec::with_capacity(N);
-        for (k, f) in faces.iter_mut().enumerate() {
-            f.sort_unstable();
-            f.dedup();
-            counts.push(f.len());
-            euler += if k % 2 == 0 {
-                f.len() as i64
-            } else {
-                -(f.len() as i64)
-            };
-        }
+        let counts = [self.vcell.len(), edges, self.tds.len()];
+        let euler = counts[0] as i64 - counts[1] as i64 + counts[2] as i64;
         if euler != 0 {
             return bad(format!(
-                "Euler characteristic {euler}, expected 0 (counts {:?})",
+                "Euler characteristic {euler}, expected 0 (V, E, C = {:?})",
                 counts
             ));
         }
