@@ -348,33 +348,26 @@ impl PeriodicDelaunay3 {
     }
 
     /// The edges (input ids, offsets), each once; `Stored` lists covering copies by vertex
-    /// id. Found from each vertex's star, towards the larger vertex id.
+    /// id. Found from each vertex's neighbours, towards the larger vertex id.
     pub fn edges(&self, copies: Copies) -> Vec<Simplex> {
-        let per_vertex = (0..self.engine.number_of_vertices() as u32).flat_map(|v| {
-            let mut around: Vec<(u32, Offset, u32, usize, usize)> = Vec::new();
-            for (c, k, _) in self.engine.star(v) {
-                let cell = self.engine.cell(c);
-                for j in (0..4).filter(|&j| cell.v[j] > v) {
-                    around.push((
-                        cell.v[j],
-                        self.space().difference(cell.off[j], cell.off[k]),
-                        c,
-                        k,
-                        j,
-                    ));
-                }
-            }
-            around.sort_unstable_by_key(|a| (a.0, a.1));
-            around.dedup_by_key(|a| (a.0, a.1));
-            around.into_iter().map(move |(_, _, c, k, j)| (c, k, j))
+        let id = move |x: u32| match copies {
+            Copies::Unique => self.point_input[self.engine.point_of(x) as usize],
+            Copies::Stored => x,
+        };
+        let all = (0..self.engine.number_of_vertices() as u32).flat_map(move |v| {
+            self.engine
+                .neighbours(v)
+                .into_iter()
+                .filter(move |w| w.0 > v)
+                .map(move |(w, rel)| {
+                    let (vertices, offsets) = canonical(&[id(v), id(w)], &[[0; 3], rel]);
+                    Simplex { vertices, offsets }
+                })
         });
         if copies == Copies::Unique && !self.is_one_sheeted() {
-            return self
-                .unique_in_covering(per_vertex.map(|(c, k, j)| self.face(c, &[k, j], copies)));
+            return self.unique_in_covering(all);
         }
-        per_vertex
-            .map(|(c, k, j)| self.face(c, &[k, j], copies))
-            .collect()
+        all.collect()
     }
 
     /// The facets, each once (from the cell with the smaller id); `Stored` lists covering
@@ -398,16 +391,13 @@ impl PeriodicDelaunay3 {
     /// the point), one entry per Delaunay edge at the point, from the point's star.
     pub fn vertex_neighbors(&self, i: usize) -> Vec<(u32, Offset)> {
         let v = self.engine.vertex_of_point(self.input_point[i]);
-        let mut out: Vec<(u32, Offset)> = Vec::new();
-        for (c, k, _) in self.engine.star(v) {
-            let cell = self.engine.cell(c);
-            for j in (0..4).filter(|&j| j != k) {
-                let id = self.point_input[self.engine.point_of(cell.v[j]) as usize];
-                out.push((id, self.space().difference(cell.off[j], cell.off[k])));
-            }
-        }
+        let mut out: Vec<(u32, Offset)> = self
+            .engine
+            .neighbours(v)
+            .into_iter()
+            .map(|(w, rel)| (self.point_input[self.engine.point_of(w) as usize], rel))
+            .collect();
         out.sort_unstable();
-        out.dedup();
         out
     }
 

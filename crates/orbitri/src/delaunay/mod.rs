@@ -229,6 +229,20 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         star
     }
 
+    /// The neighbours of vertex `v`: each (vertex, its offset relative to `v`) once, sorted.
+    pub fn neighbours(&self, v: u32) -> Vec<(u32, S::Offset)> {
+        let mut out = Vec::new();
+        for (c, k, _) in self.star(v) {
+            let cell = &self.tds.cells[c as usize];
+            for j in (0..N).filter(|&j| j != k) {
+                out.push((cell.v[j], self.space.difference(cell.off[j], cell.off[k])));
+            }
+        }
+        out.sort_unstable();
+        out.dedup();
+        out
+    }
+
     /// A vertex of point `p`: the point itself once 1-sheeted, its copy on sheet 0 (offset
     /// zero) in the covering.
     pub fn vertex_of_point(&self, p: u32) -> u32 {

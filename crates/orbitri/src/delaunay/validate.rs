@@ -78,27 +78,11 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         }
         // Euler characteristic 0 (torus, closed flat 3-manifold). Every facet is shared by
         // two cells (checked above), so F = 2C in 3D and the faces are the cells in 2D: in
-        // both, χ = V − E + C. Edges are counted from each vertex's star, towards larger ids.
-        let mut edges = 0usize;
-        let mut around: Vec<(u32, S::Offset)> = Vec::new();
-        for v in 0..self.vcell.len() as u32 {
-            around.clear();
-            for (c, k, _) in self.star(v) {
-                let cell = &self.tds.cells[c as usize];
-                for j in (0..N).filter(|&j| j != k && cell.v[j] > v) {
-                    // covering: vertex ids are unique per copy, offsets are implied
-                    let rel = if self.one_sheeted {
-                        self.space.difference(cell.off[j], cell.off[k])
-                    } else {
-                        S::Offset::default()
-                    };
-                    around.push((cell.v[j], rel));
-                }
-            }
-            around.sort_unstable();
-            around.dedup();
-            edges += around.len();
-        }
+        // both, χ = V − E + C. Edges are counted from each vertex's star, towards larger ids (in
+        // the covering, ids are unique per copy, so an edge is one (vertex, vertex) pair).
+        let edges: usize = (0..self.vcell.len() as u32)
+            .map(|v| self.neighbours(v).iter().filter(|w| w.0 > v).count())
+            .sum();
         let counts = [self.vcell.len(), edges, self.tds.len()];
         let euler = counts[0] as i64 - counts[1] as i64 + counts[2] as i64;
         if euler != 0 {
