@@ -11,6 +11,10 @@ use crate::predicates::Sign;
 
 /// An integer offset vector in lattice-vector units.
 pub type Offset3 = [i8; 3];
+
+/// Offsets are bounded by construction (see `MAX_COPIES`); overflowing them is a bug, and it
+/// must stop the program rather than silently wrap, also in release builds.
+const OFFSET_RANGE: &str = "lattice offset out of the 8-bit range";
 type L3 = Lifted<[f64; 3], Offset3>;
 
 /// The 3D flat torus of a lattice.
@@ -180,12 +184,12 @@ impl OrbitSpace<4> for FlatTorus3 {
 
     #[inline]
     fn compose(&self, a: Offset3, b: Offset3) -> Offset3 {
-        [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+        std::array::from_fn(|c| a[c].checked_add(b[c]).expect(OFFSET_RANGE))
     }
 
     #[inline]
     fn difference(&self, a: Offset3, b: Offset3) -> Offset3 {
-        [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+        std::array::from_fn(|c| a[c].checked_sub(b[c]).expect(OFFSET_RANGE))
     }
 
     #[inline(always)]

@@ -9,9 +9,10 @@ use crate::predicates::filter::Rows;
 /// shortest lattice vector are bounded by the defect, so enumerating `|x_i| ≤ 4` finds it.
 pub const MAX_DEFECT: f64 = 4.0;
 const ENUM: i32 = 4;
-/// Largest number of copies per lattice vector in the initial covering (offsets are stored in
-/// 8 bits and stay below twice this).
-pub const MAX_COPIES: i32 = 40;
+/// Largest number of copies per lattice vector in the initial covering. Offsets are stored
+/// in 8 bits: a normalized covering cell holds offsets below `2h`, and a walking query
+/// drifts by at most about one more `h`, so `3·24 = 72` stays well inside `i8`.
+pub const MAX_COPIES: i32 = 24;
 
 /// A lattice given by `D` linearly independent row vectors; the domain is
 /// `{ f·M : f ∈ [0,1)^D }`.
@@ -335,6 +336,16 @@ mod tests {
             Lattice::cuboid([1.0, 1.0, 2.0]).unwrap().covering(),
             [5, 5, 3]
         );
+        assert_eq!(
+            Lattice::cuboid([1.0, 2.0, 0.5]).unwrap().covering(),
+            [5, 3, 10]
+        );
+        // the covering of an elongated box needs many copies: at most MAX_COPIES per axis
+        assert_eq!(Lattice::cuboid([1.0, 1.0, 9.0]).unwrap().covering()[0], 19);
+        assert!(matches!(
+            Lattice::cuboid([1.0, 1.0, 14.0]),
+            Err(Error::InvalidBox(_))
+        ));
     }
 
     #[test]
