@@ -404,3 +404,33 @@ fn clustered_points_keep_the_dummy_start_without_the_criterion() {
         canonical_cells(&bulk.cells(Copies::Unique))
     );
 }
+
+#[test]
+fn degenerate_point_sets() {
+    let torus = || FlatTorus3::cuboid([1.0; 3]).unwrap();
+    // one point given fifty times
+    let same = vec![[0.3, 0.6, 0.9]; 50];
+    let tri = build(torus(), &same, BuildOptions::default());
+    assert_eq!(
+        (tri.number_of_vertices(), tri.duplicates(), tri.sheets()),
+        (1, 49, 27)
+    );
+    assert_eq!(tri.first_occurrences(), vec![0; 50]);
+    // all points on one plane, on one line, and on a plane of a grid
+    let mut r = SplitMix::new(17);
+    let plane: Vec<[f64; 3]> = (0..150).map(|_| [r.unit(), r.unit(), 0.5]).collect();
+    build(torus(), &plane, BuildOptions::default());
+    let line: Vec<[f64; 3]> = (0..40).map(|_| [r.unit(), 0.25, 0.75]).collect();
+    build(torus(), &line, BuildOptions::default());
+    let grid_plane: Vec<[f64; 3]> = (0..144)
+        .map(|i| [(i % 12) as f64 / 12.0, (i / 12) as f64 / 12.0, 0.0])
+        .collect();
+    build(
+        torus(),
+        &grid_plane,
+        BuildOptions {
+            dummy_threshold: 100,
+            ..Default::default()
+        },
+    );
+}
