@@ -180,6 +180,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// All lifted vertices of cell `c`.
     #[inline(always)]
     pub fn lifted_cell(&self, c: u32) -> LiftedCell<S, N> {
+        // (an explicit loop: `array::from_fn` and `array::map` measured 20% slower here)
         let cell = &self.tds.cells[c as usize];
         let mut out = [(self.points[0], cell.off[0]); N];
         for i in 0..N {
@@ -194,7 +195,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         let cc = &self.tds.cells[c as usize];
         let dc = &self.tds.cells[d as usize];
         let zero = S::Offset::default();
-        if cc.off.iter().all(|&o| o == zero) && dc.off.iter().all(|&o| o == zero) {
+        if cc.off == [zero; N] && dc.off == [zero; N] {
             return zero;
         }
         let k = (i + 1) % N;
