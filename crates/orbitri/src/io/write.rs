@@ -15,29 +15,23 @@ pub fn write_cells(w: &mut impl Write, tri: &PeriodicDelaunay3) -> std::io::Resu
         tri.number_of_vertices(),
         tri.number_of_cells()
     )?;
+    // integers through `itoa` into one reused line buffer: `write!` formatting took longer
+    // than the triangulation itself
+    let mut num = itoa::Buffer::new();
+    let mut line: Vec<u8> = Vec::with_capacity(96);
     for c in tri.stored_cells() {
-        let v = c.vertices;
-        let o = c.offsets;
-        writeln!(
-            w,
-            "{} {} {} {} {} {} {} {} {} {} {} {} {} {} {} {}",
-            v[0],
-            v[1],
-            v[2],
-            v[3],
-            o[0][0],
-            o[0][1],
-            o[0][2],
-            o[1][0],
-            o[1][1],
-            o[1][2],
-            o[2][0],
-            o[2][1],
-            o[2][2],
-            o[3][0],
-            o[3][1],
-            o[3][2]
-        )?;
+        line.clear();
+        for v in c.vertices {
+            line.extend_from_slice(num.format(v).as_bytes());
+            line.push(b' ');
+        }
+        for x in c.offsets.iter().flatten() {
+            line.extend_from_slice(num.format(*x).as_bytes());
+            line.push(b' ');
+        }
+        line.pop();
+        line.push(b'\n');
+        w.write_all(&line)?;
     }
     Ok(())
 }
