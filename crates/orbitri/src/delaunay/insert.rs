@@ -256,8 +256,8 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             }
         } else {
             self.points.push(p);
-            let copies = self.space.covering_copies();
-            for (k, o) in copies.into_iter().enumerate() {
+            for k in 0..self.copies.len() {
+                let o = self.copies[k];
                 let x = self.vpoint.len() as u32;
                 self.vpoint.push(pi);
                 self.vcell.push(NONE);

@@ -64,6 +64,8 @@ pub struct Engine<S: OrbitSpace<N>, const N: usize> {
     /// circumradius is too large for it, and their number.
     big: Vec<bool>,
     big_count: usize,
+    /// The offsets of one point's copies in the initial covering (computed once).
+    copies: Vec<S::Offset>,
     hint: u32,
     /// Where the last inserted point sits in the hint cell's frame, relative to its own
     /// offset: the next query (spatially close) starts its walk lifted by this translation,
@@ -77,6 +79,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// An empty triangulation of the space.
     pub fn new(space: S) -> Self {
         Engine {
+            copies: space.covering_copies(),
             space,
             points: Vec::new(),
             vpoint: Vec::new(),
