@@ -158,11 +158,6 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.vpoint[v as usize]
     }
 
-    /// One cell incident to vertex `v`.
-    pub fn incident_cell(&self, v: u32) -> u32 {
-        self.vcell[v as usize]
-    }
-
     /// The lifted vertex `i` of cell `c`.
     #[inline]
     pub fn lifted(&self, c: u32, i: usize) -> LiftedOf<S, N> {

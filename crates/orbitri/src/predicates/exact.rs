@@ -68,46 +68,6 @@ pub fn det3(a: &[BigInt; 3], b: &[BigInt; 3], c: &[BigInt; 3]) -> BigInt {
         + &a[2] * (&b[0] * &c[1] - &b[1] * &c[0])
 }
 
-/// `det [a; b]` of two rows.
-pub fn det2(a: &[BigInt; 2], b: &[BigInt; 2]) -> BigInt {
-    &a[0] * &b[1] - &a[1] * &b[0]
-}
-
-/// Determinant of a square matrix given by rows (Laplace expansion along the first row;
-/// only used for the sizes 3 and 4 of the in-sphere tests).
-pub fn det(rows: &[Vec<BigInt>]) -> BigInt {
-    let n = rows.len();
-    if n == 1 {
-        return rows[0][0].clone();
-    }
-    if n == 2 {
-        return &rows[0][0] * &rows[1][1] - &rows[0][1] * &rows[1][0];
-    }
-    let mut total = BigInt::zero();
-    for col in 0..n {
-        if rows[0][col].is_zero() {
-            continue;
-        }
-        let minor: Vec<Vec<BigInt>> = rows[1..]
-            .iter()
-            .map(|r| {
-                r.iter()
-                    .enumerate()
-                    .filter(|(j, _)| *j != col)
-                    .map(|(_, v)| v.clone())
-                    .collect()
-            })
-            .collect();
-        let term = &rows[0][col] * det(&minor);
-        if col % 2 == 0 {
-            total += term;
-        } else {
-            total -= term;
-        }
-    }
-    total
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -130,20 +90,10 @@ mod tests {
 
     #[test]
     fn determinants() {
-        let m = |v: &[i64]| v.iter().map(|&x| BigInt::from(x)).collect::<Vec<_>>();
-        let rows = vec![m(&[2, 0, 1]), m(&[1, 3, 2]), m(&[1, 1, 2])];
-        assert_eq!(det(&rows), BigInt::from(6));
         let a = [BigInt::from(2), BigInt::from(0), BigInt::from(1)];
         let b = [BigInt::from(1), BigInt::from(3), BigInt::from(2)];
         let c = [BigInt::from(1), BigInt::from(1), BigInt::from(2)];
         assert_eq!(det3(&a, &b, &c), BigInt::from(6));
-        assert_eq!(
-            det2(
-                &[BigInt::from(1), BigInt::from(2)],
-                &[BigInt::from(3), BigInt::from(4)]
-            ),
-            BigInt::from(-2)
-        );
         assert_eq!(sign(&BigInt::from(-4)), Sign::Negative);
     }
 }

@@ -22,18 +22,6 @@ pub enum Sign {
 }
 
 impl Sign {
-    /// The sign of a floating-point value (`NaN` is never passed here).
-    #[inline]
-    pub fn of(x: f64) -> Sign {
-        if x > 0.0 {
-            Sign::Positive
-        } else if x < 0.0 {
-            Sign::Negative
-        } else {
-            Sign::Zero
-        }
-    }
-
     /// The opposite sign.
     #[inline]
     pub fn flip(self) -> Sign {

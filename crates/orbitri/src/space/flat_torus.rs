@@ -59,11 +59,6 @@ impl FlatTorus3 {
         &self.lattice
     }
 
-    /// Copies per lattice vector of the initial covering space.
-    pub fn covering_factors(&self) -> [i32; 3] {
-        self.covering
-    }
-
     /// Cartesian position of a lifted point (rounded).
     pub fn position(&self, (p, o): L3) -> [f64; 3] {
         let (s, _) = self.lattice.rows.apply(widen(o));
@@ -380,22 +375,6 @@ impl OrbitSpace<4> for FlatTorus3 {
         let q = f.map(|v| ((v.clamp(0.0, 1.0) * scale) as u64).min((1 << 21) - 1) as u32);
         crate::sort::hilbert3(q, 21)
     }
-
-    fn volume(&self, s: &[L3; 4]) -> f64 {
-        let rows = &self.lattice.rows;
-        let t0 = widen(s[0].1);
-        let d: [[f64; 3]; 3] = std::array::from_fn(|i| {
-            lifted_diff(rows, &s[i + 1].0, widen(s[i + 1].1), &s[0].0, t0).0
-        });
-        (d[0][0] * (d[1][1] * d[2][2] - d[1][2] * d[2][1])
-            - d[0][1] * (d[1][0] * d[2][2] - d[1][2] * d[2][0])
-            + d[0][2] * (d[1][0] * d[2][1] - d[1][1] * d[2][0]))
-            / 6.0
-    }
-
-    fn domain_volume(&self) -> f64 {
-        self.lattice.volume()
-    }
 }
 
 #[cfg(test)]
@@ -507,7 +486,6 @@ mod tests {
         let t = unit();
         let s = corner_tetrahedron();
         assert!((t.circumradius2(&s) - 0.1875).abs() < 1e-15);
-        assert!((t.volume(&s) - 0.125 / 6.0).abs() < 1e-15);
         let mut off = [[1i8, 2, 0], [1, 1, 0], [2, 1, 1], [1, 1, 0]];
         t.normalize(&mut off, true);
         assert_eq!(off, [[0, 1, 0], [0, 0, 0], [1, 0, 1], [0, 0, 0]]);

@@ -103,11 +103,6 @@ impl<const D: usize> Lattice<D> {
         self.rows.m
     }
 
-    /// True for an axis-aligned box.
-    pub fn is_cuboid(&self) -> bool {
-        self.rows.diagonal
-    }
-
     /// Length of the shortest non-zero lattice vector (δ).
     pub fn systole(&self) -> f64 {
         self.systole

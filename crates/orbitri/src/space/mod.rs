@@ -56,10 +56,6 @@ pub trait OrbitSpace<const N: usize>: Sync + Send {
     /// Translates a cell's offsets by a group element of the triangulated space (the covering
     /// lattice, or the lattice itself once 1-sheeted) into canonical form.
     fn normalize(&self, off: &mut [Self::Offset; N], one_sheeted: bool);
-    /// True for the neutral element.
-    fn is_identity(&self, o: Self::Offset) -> bool {
-        o == Self::Offset::default()
-    }
     /// A dummy point set whose Delaunay triangulation satisfies the switch criterion.
     fn dummy_points(&self) -> Vec<Self::Point>;
     /// Number of sheets of the initial covering (`covering_copies().len()`).
@@ -81,8 +77,4 @@ pub trait OrbitSpace<const N: usize>: Sync + Send {
     fn edge_bound(&self, one_sheeted: bool) -> f64;
     /// A key along a space-filling curve, for spatial sorting.
     fn spatial_key(&self, p: &Self::Point) -> u64;
-    /// Signed volume of a lifted cell (approximate).
-    fn volume(&self, s: &[Lifted<Self::Point, Self::Offset>; N]) -> f64;
-    /// Volume of the fundamental domain.
-    fn domain_volume(&self) -> f64;
 }
