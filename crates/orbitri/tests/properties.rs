@@ -55,3 +55,33 @@ proptest! {
         }
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 16, ..ProptestConfig::default() })]
+
+    /// Any lattice: full 3×3 matrices (rotated, sheared), random points, both build paths.
+    #[test]
+    fn random_lattices(
+        diag in prop::array::uniform3(0.8f64..1.3),
+        shear in prop::array::uniform6(-0.35f64..0.35),
+        n in 1usize..120,
+        seed in any::<u64>(),
+        dummies in any::<bool>(),
+    ) {
+        let rows = [
+            [diag[0], shear[0], shear[1]],
+            [shear[2], diag[1], shear[3]],
+            [shear[4], shear[5], diag[2]],
+        ];
+        let s = FlatTorus3::triclinic(rows).unwrap();
+        let mut r = orbitri::sort::SplitMix::new(seed);
+        let pts: Vec<[f64; 3]> = (0..n).map(|_| {
+            let f = [r.unit(), r.unit(), r.unit()];
+            std::array::from_fn(|c| (0..3).map(|k| f[k] * rows[k][c]).sum())
+        }).collect();
+        let opts = BuildOptions { dummy_threshold: if dummies { 0 } else { usize::MAX }, ..Default::default() };
+        let tri = PeriodicDelaunay3::build_with(s, &pts, opts, |_| {}).unwrap();
+        prop_assert!(tri.is_valid().is_ok(), "{:?}", tri.is_valid());
+        brute_force_check(&tri, &pts);
+    }
+}
