@@ -194,42 +194,36 @@ pub fn data_dir() -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data")
 }
 
+/// The rows of numbers of a whitespace-separated file in `tests/data`.
+fn rows<T: std::str::FromStr>(file: &str) -> Vec<Vec<T>>
+where
+    T::Err: std::fmt::Debug,
+{
+    let text = std::fs::read_to_string(data_dir().join(file)).unwrap();
+    text.lines()
+        .filter(|l| !l.trim().is_empty())
+        .map(|l| l.split_whitespace().map(|s| s.parse().unwrap()).collect())
+        .collect()
+}
+
 /// Reads an oracle input: first line the periods, then points.
 pub fn read_oracle_input(name: &str) -> ([f64; 3], Vec<[f64; 3]>) {
-    let text = std::fs::read_to_string(data_dir().join(format!("{name}.txt"))).unwrap();
-    let mut lines = text.lines();
-    let per: Vec<f64> = lines
-        .next()
-        .unwrap()
-        .split_whitespace()
-        .map(|s| s.parse().unwrap())
-        .collect();
-    let pts = lines
-        .filter(|l| !l.trim().is_empty())
-        .map(|l| {
-            let v: Vec<f64> = l.split_whitespace().map(|s| s.parse().unwrap()).collect();
-            [v[0], v[1], v[2]]
-        })
-        .collect();
-    ([per[0], per[1], per[2]], pts)
+    let r: Vec<Vec<f64>> = rows(&format!("{name}.txt"));
+    (
+        [r[0][0], r[0][1], r[0][2]],
+        r[1..].iter().map(|v| [v[0], v[1], v[2]]).collect(),
+    )
 }
 
 /// Reads an oracle dump: header and canonical lines.
 pub fn read_dump(name: &str) -> ((usize, usize, usize), Vec<[i64; 16]>) {
-    let text = std::fs::read_to_string(data_dir().join(format!("{name}.dump3"))).unwrap();
-    let mut lines = text.lines();
-    let h: Vec<usize> = lines
-        .next()
-        .unwrap()
-        .split_whitespace()
-        .map(|s| s.parse().unwrap())
-        .collect();
-    let cells = lines
-        .filter(|l| !l.trim().is_empty())
-        .map(|l| {
-            let v: Vec<i64> = l.split_whitespace().map(|s| s.parse().unwrap()).collect();
-            std::array::from_fn(|i| v[i])
-        })
-        .collect();
-    ((h[0], h[1], h[2]), cells)
+    let r: Vec<Vec<i64>> = rows(&format!("{name}.dump3"));
+    let h = &r[0];
+    (
+        (h[0] as usize, h[1] as usize, h[2] as usize),
+        r[1..]
+            .iter()
+            .map(|v| std::array::from_fn(|i| v[i]))
+            .collect(),
+    )
 }
