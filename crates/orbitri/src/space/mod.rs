@@ -5,7 +5,7 @@ mod flat_torus;
 mod lattice;
 
 pub use flat_torus::FlatTorus3;
-pub use lattice::Lattice;
+pub use lattice::{Lattice, MAX_COPIES, MAX_DEFECT};
 
 use crate::predicates::Sign;
 use std::fmt::Debug;
