@@ -33,14 +33,14 @@ impl SplitMix {
     }
 }
 
-/// Index of the grid cell `x` (each coordinate below `2^bits`, `bits ≤ 21`) along the 3D
-/// Hilbert curve.
-pub fn hilbert3(mut x: [u32; 3], bits: u32) -> u64 {
+/// Index of the grid cell `x` (each coordinate below `2^bits`, `D·bits ≤ 64`) along the
+/// `D`-dimensional Hilbert curve.
+pub fn hilbert<const D: usize>(mut x: [u32; D], bits: u32) -> u64 {
     let top = 1u32 << (bits - 1);
     let mut q = top;
     while q > 1 {
         let p = q - 1;
-        for i in 0..3 {
+        for i in 0..D {
             if x[i] & q != 0 {
                 x[0] ^= p;
             } else {
@@ -51,12 +51,13 @@ pub fn hilbert3(mut x: [u32; 3], bits: u32) -> u64 {
         }
         q >>= 1;
     }
-    x[1] ^= x[0];
-    x[2] ^= x[1];
+    for i in 1..D {
+        x[i] ^= x[i - 1];
+    }
     let mut t = 0;
     let mut q = top;
     while q > 1 {
-        if x[2] & q != 0 {
+        if x[D - 1] & q != 0 {
             t ^= q - 1;
         }
         q >>= 1;
@@ -120,7 +121,7 @@ mod tests {
         for x in 0..side {
             for y in 0..side {
                 for z in 0..side {
-                    cells[hilbert3([x, y, z], bits) as usize] = [x, y, z];
+                    cells[hilbert([x, y, z], bits) as usize] = [x, y, z];
                 }
             }
         }
@@ -128,6 +129,20 @@ mod tests {
             let d: u32 = (0..3).map(|i| w[0][i].abs_diff(w[1][i])).sum();
             assert_eq!(d, 1, "{:?} -> {:?}", w[0], w[1]);
         }
+    }
+
+    #[test]
+    fn hilbert_curve_in_2d() {
+        let side = 1u32 << 4;
+        let mut cells = vec![[0u32; 2]; (side * side) as usize];
+        for x in 0..side {
+            for y in 0..side {
+                cells[hilbert([x, y], 4) as usize] = [x, y];
+            }
+        }
+        assert!(cells
+            .windows(2)
+            .all(|w| w[0][0].abs_diff(w[1][0]) + w[0][1].abs_diff(w[1][1]) == 1));
     }
 
     #[test]

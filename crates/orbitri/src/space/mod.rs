@@ -2,9 +2,10 @@
 //! predicates on lifted points, its covering space and its switch criterion.
 
 mod flat_torus;
+mod flat_torus3;
 mod lattice;
 
-pub use flat_torus::FlatTorus3;
+pub use flat_torus::{FlatTorus, FlatTorus3, Offset3};
 pub use lattice::{Lattice, MAX_COPIES, MAX_DEFECT};
 
 use crate::predicates::Sign;

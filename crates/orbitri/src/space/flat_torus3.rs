@@ -1,0 +1,244 @@
+//! The 3D flat torus: orientation and in-sphere determinants of lifted tetrahedra, and the
+//! rest of its orbit-space plug-in.
+
+use num_bigint::BigInt;
+
+use super::flat_torus::{flat_torus_plugin, widen, L};
+use super::{FlatTorus, OrbitSpace};
+use crate::predicates::exact;
+use crate::predicates::filter::{self, lifted_diff, plain_diff};
+use crate::predicates::Sign;
+
+type L3 = L<3>;
+
+impl FlatTorus<3> {
+    fn orient_exact(&self, s: &[L3; 4]) -> Sign {
+        let l = self.exact_lift(s);
+        let d: Vec<[BigInt; 3]> = (1..4)
+            .map(|i| std::array::from_fn(|c| &l[i][c] - &l[0][c]))
+            .collect();
+        exact::sign(&exact::det3(&d[0], &d[1], &d[2]))
+    }
+
+    fn in_sphere_exact(&self, s: &[L3; 4], q: L3) -> Sign {
+        let pts = [s[0], s[1], s[2], s[3], q];
+        let l = self.exact_lift(&pts);
+        let d: Vec<[BigInt; 3]> = (0..4)
+            .map(|i| std::array::from_fn(|c| &l[i][c] - &l[4][c]))
+            .collect();
+        let len: Vec<BigInt> = d
+            .iter()
+            .map(|r| &r[0] * &r[0] + &r[1] * &r[1] + &r[2] * &r[2])
+            .collect();
+        let det = -&len[0] * exact::det3(&d[1], &d[2], &d[3])
+            + &len[1] * exact::det3(&d[0], &d[2], &d[3])
+            - &len[2] * exact::det3(&d[0], &d[1], &d[3])
+            + &len[3] * exact::det3(&d[0], &d[1], &d[2]);
+        exact::sign(&det).flip()
+    }
+}
+
+impl OrbitSpace<4> for FlatTorus<3> {
+    type Point = [f64; 3];
+    type Offset = [i8; 3];
+
+    flat_torus_plugin!(4);
+
+    #[inline(always)]
+    fn orient(&self, s: &[L3; 4]) -> Sign {
+        let mut d = [[0.0; 3]; 3];
+        let mut b = [0.0; 3];
+        if s.iter().all(|x| x.1 == s[0].1) {
+            // the common case: one frame, plain differences (translation invariance)
+            for i in 0..3 {
+                (d[i], b[i]) = plain_diff(&s[i + 1].0, &s[0].0);
+            }
+        } else {
+            let rows = &self.lattice.rows;
+            let t0 = widen(s[0].1);
+            for i in 0..3 {
+                (d[i], b[i]) = lifted_diff(rows, &s[i + 1].0, widen(s[i + 1].1), &s[0].0, t0);
+            }
+        }
+        filter::orient3(&d, b).unwrap_or_else(|| self.orient_exact(s))
+    }
+
+    #[inline(always)]
+    fn in_sphere(&self, s: &[L3; 4], q: L3) -> Sign {
+        let mut d = [[0.0; 3]; 4];
+        let mut b = [0.0; 4];
+        if s.iter().all(|x| x.1 == q.1) {
+            for i in 0..4 {
+                (d[i], b[i]) = plain_diff(&s[i].0, &q.0);
+            }
+        } else {
+            let rows = &self.lattice.rows;
+            let tq = widen(q.1);
+            for i in 0..4 {
+                (d[i], b[i]) = lifted_diff(rows, &s[i].0, widen(s[i].1), &q.0, tq);
+            }
+        }
+        match filter::in_sphere3(&d, b).unwrap_or_else(|| self.in_sphere_exact(s, q)) {
+            Sign::Zero => self.perturbed(s, q, |t| self.orient(t)),
+            sign => sign,
+        }
+    }
+
+    fn circumradius2(&self, s: &[L3; 4]) -> f64 {
+        let rows = &self.lattice.rows;
+        let t0 = widen(s[0].1);
+        let d: [[f64; 3]; 3] = std::array::from_fn(|i| {
+            lifted_diff(rows, &s[i + 1].0, widen(s[i + 1].1), &s[0].0, t0).0
+        });
+        let l: [f64; 3] =
+            std::array::from_fn(|i| d[i][0] * d[i][0] + d[i][1] * d[i][1] + d[i][2] * d[i][2]);
+        let cross = |a: &[f64; 3], b: &[f64; 3]| {
+            [
+                a[1] * b[2] - a[2] * b[1],
+                a[2] * b[0] - a[0] * b[2],
+                a[0] * b[1] - a[1] * b[0],
+            ]
+        };
+        let (c12, c20, c01) = (
+            cross(&d[1], &d[2]),
+            cross(&d[2], &d[0]),
+            cross(&d[0], &d[1]),
+        );
+        let det = d[0][0] * c12[0] + d[0][1] * c12[1] + d[0][2] * c12[2];
+        if det == 0.0 {
+            return f64::INFINITY;
+        }
+        let c: [f64; 3] =
+            std::array::from_fn(|k| (l[0] * c12[k] + l[1] * c20[k] + l[2] * c01[k]) / (2.0 * det));
+        let r2 = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
+        if r2.is_nan() {
+            f64::INFINITY
+        } else {
+            r2
+        }
+    }
+
+    fn spatial_key(&self, p: &[f64; 3]) -> u64 {
+        crate::sort::hilbert(self.grid_cell(p, 21), 21)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::space::FlatTorus3;
+
+    fn unit() -> FlatTorus3 {
+        FlatTorus3::cuboid([1.0; 3]).unwrap()
+    }
+
+    /// The corner of a cube of side 0.5 at the origin: its circumsphere passes through all
+    /// eight corners of that cube.
+    fn corner_tetrahedron() -> [L3; 4] {
+        let z = [0i8; 3];
+        [
+            ([0.0, 0.0, 0.0], z),
+            ([0.5, 0.0, 0.0], z),
+            ([0.0, 0.5, 0.0], z),
+            ([0.0, 0.0, 0.5], z),
+        ]
+    }
+
+    #[test]
+    fn orientation_and_in_sphere_conventions() {
+        let t = unit();
+        let z = [0i8; 3];
+        let s = [
+            ([0.1, 0.1, 0.1], z),
+            ([0.6, 0.1, 0.1], z),
+            ([0.1, 0.6, 0.1], z),
+            ([0.1, 0.1, 0.6], z),
+        ];
+        assert_eq!(t.orient(&s), Sign::Positive);
+        assert_eq!(t.in_sphere(&s, ([0.2, 0.2, 0.2], z)), Sign::Positive);
+        assert_eq!(t.in_sphere(&s, ([0.9, 0.9, 0.9], z)), Sign::Negative);
+        // the same point one period away is outside
+        assert_eq!(
+            t.in_sphere(&s, ([0.2, 0.2, 0.2], [1, 0, 0])),
+            Sign::Negative
+        );
+        // a lifted copy of the whole configuration gives the same answers
+        let o = [1i8, -1, 2];
+        let s2 = s.map(|(p, _)| (p, o));
+        assert_eq!(t.orient(&s2), Sign::Positive);
+        assert_eq!(t.in_sphere(&s2, ([0.2, 0.2, 0.2], o)), Sign::Positive);
+    }
+
+    #[test]
+    fn exact_on_tiny_differences() {
+        let t = unit();
+        let z = [0i8; 3];
+        let e = 2f64.powi(-60);
+        // nearly flat: the filter must defer, the exact answer is positive
+        let s = [
+            ([0.0, 0.0, 0.0], z),
+            ([0.5, 0.0, 0.0], z),
+            ([0.0, 0.5, 0.0], z),
+            ([0.25, 0.25, e], z),
+        ];
+        assert!(filter::orient3(
+            &[[0.5, 0.0, 0.0], [0.0, 0.5, 0.0], [0.25, 0.25, e]],
+            [0.5; 3]
+        )
+        .is_none());
+        assert_eq!(t.orient(&s), Sign::Positive);
+        let mut below = s;
+        below[3].0[2] = -e;
+        assert_eq!(t.orient(&below), Sign::Negative);
+        let flat = [
+            ([0.0, 0.0, 0.5], z),
+            ([0.5, 0.0, 0.5], z),
+            ([0.0, 0.5, 0.5], z),
+            ([0.5, 0.5, 0.5], z),
+        ];
+        assert_eq!(t.orient(&flat), Sign::Zero);
+        // across the boundary: (0.9,..) at offset -1 equals (-0.1, ..)
+        let w = [
+            ([0.9, 0.0, 0.0], [-1, 0, 0]),
+            ([0.5, 0.0, 0.0], z),
+            ([0.0, 0.5, 0.0], z),
+            ([0.0, 0.0, 0.5], z),
+        ];
+        assert_eq!(t.orient(&w), Sign::Positive);
+    }
+
+    #[test]
+    fn cospherical_ties_are_perturbed_consistently() {
+        let t = unit();
+        let z = [0i8; 3];
+        // corners of a cube: all cospherical
+        let s = corner_tetrahedron();
+        let q = ([0.5, 0.5, 0.5], z);
+        let base = t.in_sphere(&s, q);
+        assert_ne!(base, Sign::Zero);
+        for o in [[1i8, 0, 0], [0, -1, 3], [2, 2, 2]] {
+            let s2 = s.map(|(p, _)| (p, o));
+            assert_eq!(t.in_sphere(&s2, (q.0, o)), base, "copy {o:?}");
+        }
+        assert!(t.coincide(([0.0, 0.5, 0.5], [1, 0, 0]), ([1.0, 0.5, 0.5], z)));
+        assert!(!t.coincide(([0.0, 0.5, 0.5], [1, 0, 0]), ([0.5, 0.5, 0.5], z)));
+        assert_eq!(
+            t.compare_lifted(([0.0, 0.9, 0.0], [1, 0, 0]), ([0.5, 0.0, 0.0], z)),
+            Sign::Positive
+        );
+    }
+
+    #[test]
+    fn circumradius_and_normalize() {
+        let t = unit();
+        let s = corner_tetrahedron();
+        assert!((t.circumradius2(&s) - 0.1875).abs() < 1e-15);
+        let mut off = [[1i8, 2, 0], [1, 1, 0], [2, 1, 1], [1, 1, 0]];
+        t.normalize(&mut off, true);
+        assert_eq!(off, [[0, 1, 0], [0, 0, 0], [1, 0, 1], [0, 0, 0]]);
+        let mut off = [[4i8, -1, 0], [3, 0, 0], [4, 0, 1], [3, 0, 0]];
+        t.normalize(&mut off, false);
+        assert_eq!(off, [[1, 2, 0], [0, 3, 0], [1, 3, 1], [0, 3, 0]]);
+        assert_eq!(t.covering_copies().len(), 27);
+    }
+}
