@@ -115,17 +115,7 @@ pub fn orient3(d: &[[f64; 3]; 3], b: [f64; 3]) -> Option<Sign> {
         return None;
     }
     let det = det3(&d[0], &d[1], &d[2]);
-    let err = 160.0 * U * b[0] * b[1] * b[2];
-    if det > err {
-        Some(Sign::Positive)
-    } else if det < -err {
-        Some(Sign::Negative)
-    } else if err == 0.0 {
-        // All rows are exactly zero vectors: the determinant is exactly zero.
-        Some(Sign::Zero)
-    } else {
-        None
-    }
+    decide(det, 160.0 * U * b[0] * b[1] * b[2])
 }
 
 /// In-sphere determinant for rows `d_i = a_i − q` (bounds `b`): positive when `q` is inside
@@ -146,12 +136,50 @@ pub fn in_sphere3(d: &[[f64; 3]; 4], b: [f64; 4]) -> Option<Sign> {
         - l[2] * det3(&d[0], &d[1], &d[3])
         + l[3] * det3(&d[0], &d[1], &d[2]);
     let bmax = b[0].max(b[1]).max(b[2]).max(b[3]);
-    let err = 4096.0 * U * bmax * b[0] * b[1] * b[2] * b[3];
     // inside ⇔ det < 0 for this row layout
-    if det < -err {
+    decide(-det, 4096.0 * U * bmax * b[0] * b[1] * b[2] * b[3])
+}
+
+/// Orientation of the triangle with edge vectors `d1, d2` (bounds `b`).
+///
+/// Bound: each of the 2 products is off by at most `((1+6u)²−1)·B₁B₂(1+u)² ≤ 12.1u·B₁B₂`
+/// from the inputs and `2u·B₁B₂` from its evaluation; `2·14.1 < 64`.
+#[inline]
+pub fn orient2(d: &[[f64; 2]; 2], b: [f64; 2]) -> Option<Sign> {
+    if !(in_range(b[0]) && in_range(b[1])) {
+        return None;
+    }
+    let det = d[0][0] * d[1][1] - d[0][1] * d[1][0];
+    decide(det, 64.0 * U * b[0] * b[1])
+}
+
+/// In-circle determinant for rows `d_i = a_i − q` (bounds `b`): positive when `q` is inside
+/// the circle of the counter-clockwise `a_0, a_1, a_2`.
+///
+/// Bound: the 6 terms `l_i·(two entries of the other rows)` are each at most `2·B_max·ΠB`;
+/// relative to that, the inputs contribute `2·6u + 13u` and the evaluation about `6u`;
+/// `12·31u < 1024u`.
+#[inline]
+pub fn in_circle(d: &[[f64; 2]; 3], b: [f64; 3]) -> Option<Sign> {
+    if !b.iter().all(|&x| in_range(x)) {
+        return None;
+    }
+    let l: [f64; 3] = std::array::from_fn(|i| d[i][0] * d[i][0] + d[i][1] * d[i][1]);
+    let m = |a: usize, c: usize| d[a][0] * d[c][1] - d[a][1] * d[c][0];
+    let det = l[0] * m(1, 2) - l[1] * m(0, 2) + l[2] * m(0, 1);
+    let bmax = b[0].max(b[1]).max(b[2]);
+    decide(det, 1024.0 * U * bmax * b[0] * b[1] * b[2])
+}
+
+/// The sign of `det` when its error is below `err`; an exact zero when everything is zero.
+#[inline]
+fn decide(det: f64, err: f64) -> Option<Sign> {
+    if det > err {
         Some(Sign::Positive)
-    } else if det > err {
+    } else if det < -err {
         Some(Sign::Negative)
+    } else if err == 0.0 {
+        Some(Sign::Zero)
     } else {
         None
     }
@@ -160,16 +188,7 @@ pub fn in_sphere3(d: &[[f64; 3]; 4], b: [f64; 4]) -> Option<Sign> {
 /// Sign of one lifted coordinate difference component with its bound, or `None`.
 #[inline]
 pub fn component(d: f64, b: f64) -> Option<Sign> {
-    let err = 6.0 * U * b;
-    if d > err {
-        Some(Sign::Positive)
-    } else if d < -err {
-        Some(Sign::Negative)
-    } else if b == 0.0 {
-        Some(Sign::Zero)
-    } else {
-        None
-    }
+    decide(d, 6.0 * U * b)
 }
 
 #[cfg(test)]

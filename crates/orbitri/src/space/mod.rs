@@ -2,6 +2,7 @@
 //! predicates on lifted points, its covering space and its switch criterion.
 
 mod flat_torus;
+mod flat_torus2;
 mod flat_torus3;
 mod lattice;
 

@@ -1,0 +1,140 @@
+//! The 2D flat torus: orientation and in-circle determinants of lifted triangles, and the
+//! rest of its orbit-space plug-in. Everything else is shared with 3D (`flat_torus.rs`) and
+//! the engine is the same.
+
+use num_bigint::BigInt;
+
+use super::flat_torus::{flat_torus_plugin, widen, L};
+use super::{FlatTorus, OrbitSpace};
+use crate::predicates::exact;
+use crate::predicates::filter::{self, lifted_diff, plain_diff};
+use crate::predicates::Sign;
+
+type L2 = L<2>;
+
+impl FlatTorus<2> {
+    /// Difference rows `s[i] − base` (lifted) with their bounds, the fast path when all share
+    /// one frame.
+    #[inline(always)]
+    fn rows<const K: usize>(&self, s: [&L2; K], base: &L2) -> ([[f64; 2]; K], [f64; K]) {
+        let mut d = [[0.0; 2]; K];
+        let mut b = [0.0; K];
+        let same = s.iter().all(|x| x.1 == base.1);
+        for i in 0..K {
+            (d[i], b[i]) = if same {
+                plain_diff(&s[i].0, &base.0)
+            } else {
+                lifted_diff(
+                    &self.lattice.rows,
+                    &s[i].0,
+                    widen(s[i].1),
+                    &base.0,
+                    widen(base.1),
+                )
+            };
+        }
+        (d, b)
+    }
+
+    fn orient_exact(&self, s: &[L2; 3]) -> Sign {
+        let l = self.exact_lift(s);
+        let d: Vec<[BigInt; 2]> = (1..3)
+            .map(|i| std::array::from_fn(|c| &l[i][c] - &l[0][c]))
+            .collect();
+        exact::sign(&(&d[0][0] * &d[1][1] - &d[0][1] * &d[1][0]))
+    }
+
+    fn in_circle_exact(&self, s: &[L2; 3], q: L2) -> Sign {
+        let l = self.exact_lift(&[s[0], s[1], s[2], q]);
+        let d: Vec<[BigInt; 2]> = (0..3)
+            .map(|i| std::array::from_fn(|c| &l[i][c] - &l[3][c]))
+            .collect();
+        let len: Vec<BigInt> = d.iter().map(|r| &r[0] * &r[0] + &r[1] * &r[1]).collect();
+        let m = |a: usize, b: usize| &d[a][0] * &d[b][1] - &d[a][1] * &d[b][0];
+        exact::sign(&(&len[0] * m(1, 2) - &len[1] * m(0, 2) + &len[2] * m(0, 1)))
+    }
+}
+
+impl OrbitSpace<3> for FlatTorus<2> {
+    type Point = [f64; 2];
+    type Offset = [i8; 2];
+
+    flat_torus_plugin!(3);
+
+    #[inline(always)]
+    fn orient(&self, s: &[L2; 3]) -> Sign {
+        let (d, b) = self.rows([&s[1], &s[2]], &s[0]);
+        filter::orient2(&d, b).unwrap_or_else(|| self.orient_exact(s))
+    }
+
+    #[inline(always)]
+    fn in_sphere(&self, s: &[L2; 3], q: L2) -> Sign {
+        let (d, b) = self.rows([&s[0], &s[1], &s[2]], &q);
+        match filter::in_circle(&d, b).unwrap_or_else(|| self.in_circle_exact(s, q)) {
+            Sign::Zero => self.perturbed(s, q, |t| self.orient(t)),
+            sign => sign,
+        }
+    }
+
+    fn circumradius2(&self, s: &[L2; 3]) -> f64 {
+        let (d, _) = self.rows([&s[1], &s[2]], &s[0]);
+        let (l1, l2) = (
+            d[0][0] * d[0][0] + d[0][1] * d[0][1],
+            d[1][0] * d[1][0] + d[1][1] * d[1][1],
+        );
+        let det = 2.0 * (d[0][0] * d[1][1] - d[0][1] * d[1][0]);
+        let ux = (d[1][1] * l1 - d[0][1] * l2) / det;
+        let uy = (d[0][0] * l2 - d[1][0] * l1) / det;
+        let r2 = ux * ux + uy * uy;
+        if r2.is_finite() {
+            r2
+        } else {
+            f64::INFINITY
+        }
+    }
+
+    fn spatial_key(&self, p: &[f64; 2]) -> u64 {
+        crate::sort::hilbert(self.grid_cell(p, 31), 31)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn orientation_and_in_circle_conventions() {
+        let t = FlatTorus::<2>::cuboid([1.0, 1.0]).unwrap();
+        let z = [0i8; 2];
+        let s = [([0.1, 0.1], z), ([0.6, 0.1], z), ([0.1, 0.6], z)];
+        assert_eq!(t.orient(&s), Sign::Positive);
+        assert_eq!(t.in_sphere(&s, ([0.2, 0.2], z)), Sign::Positive);
+        assert_eq!(t.in_sphere(&s, ([0.9, 0.9], z)), Sign::Negative);
+        assert_eq!(t.in_sphere(&s, ([0.2, 0.2], [1, 0])), Sign::Negative);
+        let o = [2i8, -1];
+        assert_eq!(
+            t.in_sphere(&s.map(|(p, _)| (p, o)), ([0.2, 0.2], o)),
+            Sign::Positive
+        );
+        // four corners of a square are cocircular: the perturbation decides, the same for
+        // every periodic copy
+        let sq = [([0.0, 0.0], z), ([0.5, 0.0], z), ([0.0, 0.5], z)];
+        let base = t.in_sphere(&sq, ([0.5, 0.5], z));
+        assert_ne!(base, Sign::Zero);
+        assert_eq!(
+            t.in_sphere(&sq.map(|(p, _)| (p, [1, 1])), ([0.5, 0.5], [1, 1])),
+            base
+        );
+        assert!((t.circumradius2(&sq) - 0.125).abs() < 1e-15);
+        // nearly collinear: only the exact evaluation can tell
+        let e = 2f64.powi(-60);
+        assert_eq!(
+            t.orient(&[([0.0, 0.0], z), ([0.5, 0.0], z), ([0.25, e], z)]),
+            Sign::Positive
+        );
+        assert_eq!(
+            t.orient(&[([0.0, 0.0], z), ([0.5, 0.0], z), ([0.25, -e], z)]),
+            Sign::Negative
+        );
+    }
+}
