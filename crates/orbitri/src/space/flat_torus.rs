@@ -134,7 +134,9 @@ impl<const D: usize> FlatTorus<D> {
     /// The symbolic perturbation of a cospherical in-sphere test (Devillers–Teillaud): sort
     /// the lifted points of the simplex and the query lexicographically and, from the largest
     /// down, return the first non-zero coefficient of the perturbed determinant: the
-    /// orientation of the simplex with that point replaced by the query.
+    /// orientation of the simplex with that point replaced by the query. Every term is
+    /// tried (CGAL stops after two, which its paper shows suffices); the query's own term
+    /// ends the loop.
     pub(super) fn perturbed<const N: usize>(
         &self,
         s: &[L<D>; N],
@@ -150,8 +152,9 @@ impl<const D: usize> FlatTorus<D> {
                 j -= 1;
             }
         }
-        for &idx in order.iter().rev().take(N - 1) {
+        for &idx in order.iter().rev() {
             if idx == N {
+                // the query's own coefficient is the orientation of `s`: positive
                 return Sign::Negative;
             }
             let mut t = *s;
@@ -161,8 +164,7 @@ impl<const D: usize> FlatTorus<D> {
                 return o;
             }
         }
-        debug_assert!(false, "perturbation undecided: {s:?} {q:?}");
-        Sign::Negative
+        unreachable!("the order holds the query, whose coefficient is never zero")
     }
 
     #[inline]
