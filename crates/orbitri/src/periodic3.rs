@@ -135,6 +135,7 @@ impl PeriodicDelaunay3 {
         if points.len() >= opts.dummy_threshold
             && tri.build_from_dummies(&wrapped_pts, &order, &progress)
         {
+            tri.represent_first_occurrences(&wrapped_pts);
             return Ok(tri);
         }
         let mut tri = PeriodicDelaunay3::new(space);
@@ -149,8 +150,35 @@ impl PeriodicDelaunay3 {
         if !tri.engine.is_one_sheeted() {
             tri.engine.try_one_sheet();
         }
+        tri.represent_first_occurrences(&wrapped_pts);
         progress(points.len());
         Ok(tri)
+    }
+
+    /// After a build in spatial order: every point that met duplicates takes the wrapped
+    /// coordinates of its first occurrence, as the output formats promise (offsets are
+    /// relative to input `i`'s wrapped point). Duplicates can differ from it by an exact
+    /// lattice translation, which the offsets of the point's star absorb.
+    fn represent_first_occurrences(&mut self, wrapped: &[[f64; 3]]) {
+        for p in 0..self.point_input.len() {
+            let want = wrapped[self.point_input[p] as usize];
+            let have = self.engine.points()[p];
+            if want == have {
+                continue;
+            }
+            // want + t·M == have for an integer t: found approximately, confirmed exactly
+            let d: [f64; 3] = std::array::from_fn(|c| have[c] - want[c]);
+            let t = self
+                .space()
+                .lattice()
+                .fractional(&d)
+                .map(|x| x.round() as i8);
+            let exact = self.space().coincide((want, t), (have, [0; 3]));
+            debug_assert!(exact, "a duplicate is an exact lattice translate");
+            if exact {
+                self.engine.move_representative(p as u32, want, t);
+            }
+        }
     }
 
     /// Dummy-point construction; false if it had to be abandoned (a point coincides with a

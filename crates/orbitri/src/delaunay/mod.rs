@@ -242,6 +242,24 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         out
     }
 
+    /// Gives point `p` the representative `coords`, where `coords + t·M` is its current
+    /// position: every copy's star gets its offset shifted by `t`, so no cell moves.
+    pub(crate) fn move_representative(&mut self, p: u32, coords: S::Point, t: S::Offset) {
+        let vertices: Vec<u32> = (0..self.vpoint.len() as u32)
+            .filter(|&v| self.vpoint[v as usize] == p)
+            .collect();
+        for v in vertices {
+            for (c, k, _) in self.star(v) {
+                let cell = &mut self.tds.cells[c as usize];
+                cell.off[k] = self.space.compose(cell.off[k], t);
+                let mut off = cell.off;
+                self.space.normalize(&mut off, self.one_sheeted);
+                self.tds.cells[c as usize].off = off;
+            }
+        }
+        self.points[p as usize] = coords;
+    }
+
     /// A vertex of point `p`: the point itself once 1-sheeted, its copy on sheet 0 (offset
     /// zero) in the covering.
     pub fn vertex_of_point(&self, p: u32) -> u32 {
