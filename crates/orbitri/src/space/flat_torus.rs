@@ -8,7 +8,7 @@ use num_bigint::BigInt;
 use super::{Lattice, Lifted};
 use crate::error::Result;
 use crate::predicates::exact::{self, Scaled};
-use crate::predicates::filter::{self, lifted_diff};
+use crate::predicates::filter::{self, lifted_diff, plain_diff};
 use crate::predicates::Sign;
 
 /// An integer offset vector in lattice-vector units (3D).
@@ -33,7 +33,7 @@ pub struct FlatTorus<const D: usize> {
 pub type FlatTorus3 = FlatTorus<3>;
 
 #[inline]
-pub(super) fn widen<const D: usize>(o: [i8; D]) -> [i32; D] {
+fn widen<const D: usize>(o: [i8; D]) -> [i32; D] {
     o.map(|x| x as i32)
 }
 
@@ -104,6 +104,30 @@ impl<const D: usize> FlatTorus<D> {
                 })
             })
             .collect()
+    }
+
+    /// The lifted differences `s[i] − base` with their error bounds (see
+    /// `predicates::filter`); plain coordinate differences when all share one frame, the
+    /// common case, by translation invariance.
+    #[inline(always)]
+    pub(super) fn rows<const K: usize>(
+        &self,
+        s: [&L<D>; K],
+        base: &L<D>,
+    ) -> ([[f64; D]; K], [f64; K]) {
+        let mut d = [[0.0; D]; K];
+        let mut b = [0.0; K];
+        if s.iter().all(|x| x.1 == base.1) {
+            for i in 0..K {
+                (d[i], b[i]) = plain_diff(&s[i].0, &base.0);
+            }
+        } else {
+            let t0 = widen(base.1);
+            for i in 0..K {
+                (d[i], b[i]) = lifted_diff(&self.lattice.rows, &s[i].0, widen(s[i].1), &base.0, t0);
+            }
+        }
+        (d, b)
     }
 
     /// Lexicographic order of lifted points (first coordinate, then the next…), exact. It is

@@ -4,38 +4,15 @@
 
 use num_bigint::BigInt;
 
-use super::flat_torus::{flat_torus_plugin, widen, L};
+use super::flat_torus::{flat_torus_plugin, L};
 use super::{FlatTorus, OrbitSpace};
 use crate::predicates::exact;
-use crate::predicates::filter::{self, lifted_diff, plain_diff};
+use crate::predicates::filter;
 use crate::predicates::Sign;
 
 type L2 = L<2>;
 
 impl FlatTorus<2> {
-    /// Difference rows `s[i] − base` (lifted) with their bounds, the fast path when all share
-    /// one frame.
-    #[inline(always)]
-    fn rows<const K: usize>(&self, s: [&L2; K], base: &L2) -> ([[f64; 2]; K], [f64; K]) {
-        let mut d = [[0.0; 2]; K];
-        let mut b = [0.0; K];
-        let same = s.iter().all(|x| x.1 == base.1);
-        for i in 0..K {
-            (d[i], b[i]) = if same {
-                plain_diff(&s[i].0, &base.0)
-            } else {
-                lifted_diff(
-                    &self.lattice.rows,
-                    &s[i].0,
-                    widen(s[i].1),
-                    &base.0,
-                    widen(base.1),
-                )
-            };
-        }
-        (d, b)
-    }
-
     fn orient_exact(&self, s: &[L2; 3]) -> Sign {
         let l = self.exact_lift(s);
         let d: Vec<[BigInt; 2]> = (1..3)

@@ -3,10 +3,10 @@
 
 use num_bigint::BigInt;
 
-use super::flat_torus::{flat_torus_plugin, widen, L};
+use super::flat_torus::{flat_torus_plugin, L};
 use super::{FlatTorus, OrbitSpace};
 use crate::predicates::exact;
-use crate::predicates::filter::{self, lifted_diff, plain_diff};
+use crate::predicates::filter;
 use crate::predicates::Sign;
 
 type L3 = L<3>;
@@ -46,38 +46,13 @@ impl OrbitSpace<4> for FlatTorus<3> {
 
     #[inline(always)]
     fn orient(&self, s: &[L3; 4]) -> Sign {
-        let mut d = [[0.0; 3]; 3];
-        let mut b = [0.0; 3];
-        if s.iter().all(|x| x.1 == s[0].1) {
-            // the common case: one frame, plain differences (translation invariance)
-            for i in 0..3 {
-                (d[i], b[i]) = plain_diff(&s[i + 1].0, &s[0].0);
-            }
-        } else {
-            let rows = &self.lattice.rows;
-            let t0 = widen(s[0].1);
-            for i in 0..3 {
-                (d[i], b[i]) = lifted_diff(rows, &s[i + 1].0, widen(s[i + 1].1), &s[0].0, t0);
-            }
-        }
+        let (d, b) = self.rows([&s[1], &s[2], &s[3]], &s[0]);
         filter::orient3(&d, b).unwrap_or_else(|| self.orient_exact(s))
     }
 
     #[inline(always)]
     fn in_sphere(&self, s: &[L3; 4], q: L3) -> Sign {
-        let mut d = [[0.0; 3]; 4];
-        let mut b = [0.0; 4];
-        if s.iter().all(|x| x.1 == q.1) {
-            for i in 0..4 {
-                (d[i], b[i]) = plain_diff(&s[i].0, &q.0);
-            }
-        } else {
-            let rows = &self.lattice.rows;
-            let tq = widen(q.1);
-            for i in 0..4 {
-                (d[i], b[i]) = lifted_diff(rows, &s[i].0, widen(s[i].1), &q.0, tq);
-            }
-        }
+        let (d, b) = self.rows([&s[0], &s[1], &s[2], &s[3]], &q);
         match filter::in_sphere3(&d, b).unwrap_or_else(|| self.in_sphere_exact(s, q)) {
             Sign::Zero => self.perturbed(s, q, |t| self.orient(t)),
             sign => sign,
@@ -85,11 +60,7 @@ impl OrbitSpace<4> for FlatTorus<3> {
     }
 
     fn circumradius2(&self, s: &[L3; 4]) -> f64 {
-        let rows = &self.lattice.rows;
-        let t0 = widen(s[0].1);
-        let d: [[f64; 3]; 3] = std::array::from_fn(|i| {
-            lifted_diff(rows, &s[i + 1].0, widen(s[i + 1].1), &s[0].0, t0).0
-        });
+        let (d, _) = self.rows([&s[1], &s[2], &s[3]], &s[0]);
         let l: [f64; 3] =
             std::array::from_fn(|i| d[i][0] * d[i][0] + d[i][1] * d[i][1] + d[i][2] * d[i][2]);
         let cross = |a: &[f64; 3], b: &[f64; 3]| {
