@@ -245,10 +245,14 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// Gives point `p` the representative `coords`, where `coords + t·M` is its current
     /// position: every copy's star gets its offset shifted by `t`, so no cell moves.
     pub(crate) fn move_representative(&mut self, p: u32, coords: S::Point, t: S::Offset) {
-        let vertices: Vec<u32> = (0..self.vpoint.len() as u32)
-            .filter(|&v| self.vpoint[v as usize] == p)
-            .collect();
-        for v in vertices {
+        // the point itself once 1-sheeted; its copies `p·S … p·S+S−1` in the covering
+        let copies = if self.one_sheeted {
+            1
+        } else {
+            self.space.sheets() as u32
+        };
+        for v in p * copies..(p + 1) * copies {
+            debug_assert_eq!(self.vpoint[v as usize], p);
             for (c, k, _) in self.star(v) {
                 let cell = &mut self.tds.cells[c as usize];
                 cell.off[k] = self.space.compose(cell.off[k], t);
