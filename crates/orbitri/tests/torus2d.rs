@@ -4,7 +4,7 @@
 
 use std::collections::HashMap;
 
-use orbitri::space::FlatTorus;
+use orbitri::space::{FlatTorus, Ladder, Lattice};
 use orbitri::{Engine, OrbitSpace};
 
 fn data(name: &str) -> String {
@@ -165,15 +165,25 @@ fn brute_force_empty_circles_and_areas() {
 }
 
 #[test]
-fn tiny_sets_stay_in_the_9_sheeted_covering() {
+fn the_square_ladder_is_16_8_4_2_1_and_the_grid_is_9() {
     let torus = FlatTorus::<2>::cuboid([1.0, 1.0]).unwrap();
-    assert_eq!(torus.sheets(), 9);
-    let mut e = Engine::new(torus);
-    for p in [[0.1, 0.2], [0.7, 0.4], [0.3, 0.8]] {
-        e.insert(p);
-        e.is_valid().unwrap();
-        assert_eq!(e.sheets(), 9);
+    let sheets: Vec<usize> = (0..torus.levels()).map(|k| torus.sheets(k)).collect();
+    assert_eq!(sheets, [16, 8, 4, 2, 1]);
+    let grid = FlatTorus::with_ladder(torus.lattice().clone(), Ladder::Grid);
+    assert_eq!((grid.levels(), grid.sheets(0)), (2, 9));
+}
+
+#[test]
+fn tiny_sets_stay_in_a_covering() {
+    for kind in [Ladder::Grid, Ladder::Halving] {
+        let torus = FlatTorus::<2>::with_ladder(Lattice::cuboid([1.0, 1.0]).unwrap(), kind);
+        let mut e = Engine::new(torus);
+        for p in [[0.1, 0.2], [0.7, 0.4], [0.3, 0.8]] {
+            e.insert(p);
+            e.is_valid().unwrap();
+            assert!(e.sheets() > 1);
+        }
+        // 2 triangles per vertex copy on a torus
+        assert_eq!(e.number_of_cells(), 2 * 3 * e.sheets());
     }
-    // 2 triangles per vertex copy on a torus
-    assert_eq!(e.number_of_cells(), 2 * 3 * 9);
 }

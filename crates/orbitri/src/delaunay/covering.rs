@@ -1,6 +1,6 @@
-//! Moving between the covering space and the 1-sheeted quotient: the first triangulation of
-//! each, the conversion once the switch criterion holds (or once the 1-skeleton has no cycle of
-//! length ≤ 2, Theorem 2.2.8), and the way back.
+//! Moving along the covering ladder: the first triangulation of a level, the conversion to
+//! the next level once its criterion holds (to the quotient also once the 1-skeleton has no
+//! cycle of length ≤ 2, Theorem 2.2.8), and the way back to level 0.
 
 use std::collections::HashMap;
 
@@ -9,42 +9,50 @@ use crate::space::OrbitSpace;
 use crate::tds::{Cell, Tds, NONE};
 
 impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
-    /// Candidates for gift wrapping: the lifted copies of the points near `at`,
-    /// with their vertex ids (`sheets` ids per point in the covering, one in the quotient).
+    /// The vertex id of the lifted copy `(p, o)` at the current level: `sheets` ids per
+    /// point, sheet by sheet (the point id itself in the quotient).
+    fn vertex_id(&self, p: u32, o: S::Offset) -> u32 {
+        let sheets = self.space.sheets(self.level) as u32;
+        p * sheets + self.space.sheet_of(o, self.level) as u32
+    }
+
+    /// Candidates for gift wrapping: the lifted copies of the points near `at`, with their
+    /// vertex ids.
     fn wrap_candidates(&self, at: LiftedOf<S, N>, radius: f64) -> Vec<Candidate<S, N>> {
         let mut near = Vec::new();
         self.space.near(at, &self.points, radius, &mut near);
-        let sheets = if self.one_sheeted {
-            1
-        } else {
-            self.space.sheets()
-        };
         near.into_iter()
-            .map(|(i, o)| {
-                let vid = if self.one_sheeted {
-                    i
-                } else {
-                    i * sheets as u32 + self.space.sheet_of(o) as u32
-                };
-                (vid, (self.points[i as usize], o))
-            })
+            .map(|(i, o)| (self.vertex_id(i, o), (self.points[i as usize], o)))
             .collect()
     }
 
-    /// Triangulates the current points from scratch by gift wrapping (in the covering, or in
-    /// the quotient when `one_sheeted` and the points satisfy the criterion).
-    fn bootstrap(&mut self, one_sheeted: bool) {
-        self.tds.clear();
-        self.big.clear();
-        self.big_count = 0;
-        self.guaranteed = false;
-        self.one_sheeted = one_sheeted;
-        let sheets = if one_sheeted { 1 } else { self.space.sheets() };
+    /// Moves to `level` with an empty triangulation: vertex maps and the copies and
+    /// large-cell limit of the level.
+    fn enter_level(&mut self, level: usize) {
+        self.level = level;
+        self.one_sheeted = level == self.last_level();
+        self.copies = self.space.covering_copies(level);
+        let sheets = self.copies.len();
         self.vpoint = (0..self.points.len() as u32)
             .flat_map(|p| std::iter::repeat_n(p, sheets))
             .collect();
         self.vcell = vec![NONE; self.vpoint.len()];
-        let radius = self.space.edge_bound(one_sheeted);
+        self.big_limit = self
+            .space
+            .criterion_radius2((level + 1).min(self.last_level()));
+        self.big.clear();
+        self.big_count = 0;
+        self.hint = NONE;
+        self.hint_shift = S::Offset::default();
+    }
+
+    /// Triangulates the current points from scratch by gift wrapping in the space of
+    /// `level` (level 0, or a level whose criterion the points satisfy).
+    fn bootstrap(&mut self, level: usize) {
+        self.tds.clear();
+        self.guaranteed = false;
+        self.enter_level(level);
+        let radius = self.space.edge_bound(level);
         let a = (0u32, (self.points[0], S::Offset::default()));
         let cands = self.wrap_candidates(a.1, radius);
         let max_r2 = (radius / 2.0) * (radius / 2.0) * (1.0 + 1e-9);
@@ -62,11 +70,20 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.commit(&cells);
     }
 
-    /// The covering triangulation of the first point.
+    /// The level-0 triangulation of the first point.
     pub(super) fn bootstrap_covering(&mut self) {
-        self.bootstrap(false);
-        if self.big_count == 0 {
-            self.convert_to_one_sheet();
+        self.bootstrap(0);
+        self.descend();
+    }
+
+    /// While the criterion of the next level holds (no big cell), moves to that level; once
+    /// in the quotient the criterion is guaranteed for every later insertion.
+    pub(super) fn descend(&mut self) {
+        while !self.one_sheeted && self.big_count == 0 {
+            // (the new cells are tracked against the criterion of the level after)
+            self.convert(self.level + 1);
+        }
+        if self.one_sheeted && self.big_count == 0 {
             self.set_guaranteed(true);
         }
     }
@@ -74,14 +91,13 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// The 1-sheeted triangulation of the current points, which must satisfy the criterion
     /// (the dummy point set does by construction).
     pub(crate) fn bootstrap_one_sheeted(&mut self) {
-        self.bootstrap(true);
+        self.bootstrap(self.last_level());
         self.set_guaranteed(true);
     }
 
-    /// Rebuilds the triangulation of the current points in the covering space.
+    /// Rebuilds the triangulation of the current points at level 0.
     pub(crate) fn rebuild_in_covering(&mut self) {
         let pts = std::mem::take(&mut self.points);
-        self.one_sheeted = false;
         self.guaranteed = false;
         self.points.push(pts[0]);
         self.bootstrap_covering();
@@ -122,42 +138,42 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         true
     }
 
-    /// Replaces the covering triangulation by its quotient: one cell per orbit of cells,
-    /// vertex ids become point ids. The caller guarantees the quotient is simplicial.
-    pub(crate) fn convert_to_one_sheet(&mut self) {
-        if self.one_sheeted {
+    /// Replaces the covering triangulation by its projection to the space of a later
+    /// `level`: one cell per orbit of cells under that space's group, vertex ids renumbered
+    /// for its sheets. The caller guarantees the projection is simplicial.
+    pub(crate) fn convert(&mut self, level: usize) {
+        if level <= self.level {
             return;
         }
         let old = std::mem::replace(&mut self.tds, Tds::new());
+        let old_vpoint = std::mem::take(&mut self.vpoint);
         let mut orbit = vec![NONE; old.cells.len()];
         let mut reps: Vec<u32> = Vec::new();
         let mut index: HashMap<[(u32, S::Offset); N], u32> = HashMap::new();
         for c in old.ids() {
-            let key = quotient_key(&self.space, &self.vpoint, &old.cells[c as usize]);
+            let key = quotient_key(&self.space, &old_vpoint, &old.cells[c as usize], level);
             orbit[c as usize] = *index.entry(key).or_insert_with(|| {
                 reps.push(c);
                 (reps.len() - 1) as u32
             });
         }
-        self.one_sheeted = true;
-        self.big.clear();
-        self.big_count = 0;
+        self.enter_level(level);
         self.tds.reserve(reps.len());
         for &c in &reps {
             let cell = &old.cells[c as usize];
-            let v = cell.v.map(|x| self.vpoint[x as usize]);
-            self.make_cell(v, cell.off);
+            let mut off = cell.off;
+            self.space.normalize(&mut off, level);
+            let v: [u32; N] =
+                std::array::from_fn(|i| self.vertex_id(old_vpoint[cell.v[i] as usize], off[i]));
+            self.make_cell(v, off);
         }
         for (k, &c) in reps.iter().enumerate() {
             self.tds.cells[k].n = old.cells[c as usize].n.map(|d| orbit[d as usize]);
         }
-        self.vpoint = (0..self.points.len() as u32).collect();
-        self.vcell = vec![NONE; self.points.len()];
         for k in 0..reps.len() as u32 {
             self.attach(k);
         }
         self.hint = 0;
-        self.hint_shift = S::Offset::default();
     }
 
     /// Drops the first `k` points (the dummies, once removed) and renumbers the rest.
@@ -179,7 +195,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// a triangulation even though the criterion does not guarantee it for more points.
     pub fn try_one_sheet(&mut self) -> bool {
         if !self.one_sheeted && !self.points.is_empty() && self.quotient_is_simplicial() {
-            self.convert_to_one_sheet();
+            self.convert(self.last_level());
             if self.big_count == 0 {
                 self.set_guaranteed(true);
             }
@@ -188,15 +204,16 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     }
 }
 
-/// The canonical form of a covering cell in the quotient: offsets translated by the lattice
-/// into normal form, then (point, offset) pairs sorted.
+/// The canonical form of a covering cell in the space of `level`: offsets translated by that
+/// space's group into normal form, then (point, offset) pairs sorted.
 pub(super) fn quotient_key<S: OrbitSpace<N>, const N: usize>(
     space: &S,
     vpoint: &[u32],
     cell: &Cell<S::Offset, N>,
+    level: usize,
 ) -> [(u32, S::Offset); N] {
     let mut off = cell.off;
-    space.normalize(&mut off, true);
+    space.normalize(&mut off, level);
     let mut pairs: [(u32, S::Offset); N] =
         std::array::from_fn(|i| (vpoint[cell.v[i] as usize], off[i]));
     pairs.sort_unstable();

@@ -271,10 +271,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                     return Inserted::Duplicate(self.vpoint[v as usize]);
                 }
             }
-            if self.big_count == 0 {
-                self.convert_to_one_sheet();
-                self.set_guaranteed(true);
-            }
+            self.descend();
             Inserted::New(pi)
         }
     }

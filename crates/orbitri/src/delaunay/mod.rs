@@ -1,8 +1,10 @@
 //! The incremental Delaunay engine, written once for every orbit space and dimension
-//! (`N` = vertices per cell). It stores either a triangulation of the initial covering space
-//! (every point present once per sheet) or, as soon as the switch criterion holds, of the
-//! 1-sheeted quotient. Cells store each vertex's offset in units of the original lattice, so
-//! one insertion code path serves both (thesis Algorithm 2.3.1).
+//! (`N` = vertices per cell). It stores a triangulation of one level of the space's covering
+//! ladder: a covering space (every point present once per sheet) until the criterion of the
+//! next level holds, then the next level, down to the 1-sheeted quotient (thesis Algorithm
+//! 2.3.1 with one covering; Bogdanov–Teillaud–Vegter's 8 → 4 → 2 → 1 with several). Cells
+//! store each vertex's offset in units of the original lattice, so one insertion code path
+//! serves every level.
 
 mod covering;
 mod insert;
@@ -56,15 +58,20 @@ pub struct Engine<S: OrbitSpace<N>, const N: usize> {
     /// Vertex → one incident cell.
     pub(crate) vcell: Vec<u32>,
     pub(crate) tds: Tds<S::Offset, N>,
+    /// The level of the covering ladder the triangulation lives in.
+    pub(crate) level: usize,
+    /// `level` is the last one: the quotient itself.
     pub(crate) one_sheeted: bool,
     /// True while the switch criterion is known to hold, so that further insertions keep a
     /// valid 1-sheeted triangulation.
     pub(crate) guaranteed: bool,
-    /// While the criterion is not known to hold (always in the covering): cells whose
-    /// circumradius is too large for it, and their number.
+    /// While the criterion of the next level (of the quotient once there) is not known to
+    /// hold: cells whose circumradius is too large for it, and their number.
     big: Vec<bool>,
     big_count: usize,
-    /// The offsets of one point's copies in the initial covering (computed once).
+    /// The squared circumradius that makes a cell big.
+    big_limit: f64,
+    /// The offsets of one point's copies in the current covering.
     copies: Vec<S::Offset>,
     hint: u32,
     /// Where the last inserted point sits in the hint cell's frame, relative to its own
@@ -78,13 +85,16 @@ pub struct Engine<S: OrbitSpace<N>, const N: usize> {
 impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// An empty triangulation of the space.
     pub fn new(space: S) -> Self {
+        let last = space.levels() - 1;
         Engine {
-            copies: space.covering_copies(),
+            copies: space.covering_copies(0),
+            big_limit: space.criterion_radius2(last.min(1)),
             space,
             points: Vec::new(),
             vpoint: Vec::new(),
             vcell: Vec::new(),
             tds: Tds::new(),
+            level: 0,
             one_sheeted: false,
             guaranteed: false,
             big: Vec::new(),
@@ -116,11 +126,21 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
 
     /// Number of sheets of the stored triangulation (1 once it lives in the quotient).
     pub fn sheets(&self) -> usize {
-        if self.one_sheeted || self.points.is_empty() {
+        if self.points.is_empty() {
             1
         } else {
-            self.space.sheets()
+            self.space.sheets(self.level)
         }
+    }
+
+    /// The level of the covering ladder the triangulation lives in (the last is the quotient).
+    pub fn level(&self) -> usize {
+        self.level
+    }
+
+    /// The last level: the quotient.
+    pub(crate) fn last_level(&self) -> usize {
+        self.space.levels() - 1
     }
 
     /// True when the stored triangulation is the 1-sheeted quotient.
@@ -246,18 +266,14 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// position: every copy's star gets its offset shifted by `t`, so no cell moves.
     pub(crate) fn move_representative(&mut self, p: u32, coords: S::Point, t: S::Offset) {
         // the point itself once 1-sheeted; its copies `p·S … p·S+S−1` in the covering
-        let copies = if self.one_sheeted {
-            1
-        } else {
-            self.space.sheets() as u32
-        };
+        let copies = self.space.sheets(self.level) as u32;
         for v in p * copies..(p + 1) * copies {
             debug_assert_eq!(self.vpoint[v as usize], p);
             for (c, k, _) in self.star(v) {
                 let cell = &mut self.tds.cells[c as usize];
                 cell.off[k] = self.space.compose(cell.off[k], t);
                 let mut off = cell.off;
-                self.space.normalize(&mut off, self.one_sheeted);
+                self.space.normalize(&mut off, self.level);
                 self.tds.cells[c as usize].off = off;
             }
         }
@@ -270,7 +286,8 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         if self.one_sheeted {
             p
         } else {
-            p * self.space.sheets() as u32 + self.space.sheet_of(S::Offset::default()) as u32
+            let sheets = self.space.sheets(self.level) as u32;
+            p * sheets + self.space.sheet_of(S::Offset::default(), self.level) as u32
         }
     }
 
@@ -281,7 +298,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
 
     /// Creates a cell, normalizing its offsets, and keeps the criterion bookkeeping.
     fn make_cell(&mut self, v: [u32; N], mut off: [S::Offset; N]) -> u32 {
-        self.space.normalize(&mut off, self.one_sheeted);
+        self.space.normalize(&mut off, self.level);
         let id = self.tds.create(Cell::new(v, off));
         if !self.guaranteed {
             self.track(id);
@@ -289,9 +306,9 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         id
     }
 
-    /// Records whether cell `c` is too large for the switch criterion.
+    /// Records whether cell `c` is too large for the criterion of the next level.
     fn track(&mut self, c: u32) {
-        let big = self.space.circumradius2(&self.lifted_cell(c)) >= self.space.criterion_radius2();
+        let big = self.space.circumradius2(&self.lifted_cell(c)) >= self.big_limit;
         if self.big.len() <= c as usize {
             self.big.resize(c as usize + 1, false);
         }
@@ -299,21 +316,29 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.big_count += big as usize;
     }
 
-    /// Declares whether the switch criterion is known to hold; when it stops being known,
-    /// every cell is examined so that the count of large cells is exact.
+    /// Declares whether the switch criterion of the quotient is known to hold; when it stops
+    /// being known, every cell is examined so that the count of large cells is exact.
     fn set_guaranteed(&mut self, holds: bool) {
         if holds {
             self.big.clear();
             self.big_count = 0;
         } else if self.guaranteed {
-            self.big.clear();
-            self.big_count = 0;
-            let ids: Vec<u32> = self.tds.ids().collect();
-            for c in ids {
-                self.track(c);
-            }
+            self.recount_big();
         }
         self.guaranteed = holds;
+    }
+
+    /// Examines every cell against the criterion of the level after the current one (of the
+    /// quotient once there).
+    fn recount_big(&mut self) {
+        let target = (self.level + 1).min(self.last_level());
+        self.big_limit = self.space.criterion_radius2(target);
+        self.big.clear();
+        self.big_count = 0;
+        let ids: Vec<u32> = self.tds.ids().collect();
+        for c in ids {
+            self.track(c);
+        }
     }
 
     /// Deletes a cell and keeps the criterion bookkeeping.

@@ -44,7 +44,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         let cells = self
             .wrap(seeds, |_, _| hole.clone(), Vec::new())
             .ok_or(RemoveError::NotSimplicial)?;
-        let limit = self.space.criterion_radius2();
+        let limit = self.space.criterion_radius2(self.last_level());
         let breaks = cells
             .iter()
             .any(|w| self.space.circumradius2(&w.arr) >= limit);

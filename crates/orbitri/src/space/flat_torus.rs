@@ -5,6 +5,7 @@
 
 use num_bigint::BigInt;
 
+use super::lattice::{Ladder, Level};
 use super::{Lattice, Lifted};
 use crate::error::Result;
 use crate::predicates::exact::{self, Scaled};
@@ -25,9 +26,13 @@ pub(super) type L<const D: usize> = Lifted<[f64; D], [i8; D]>;
 #[derive(Clone, Debug)]
 pub struct FlatTorus<const D: usize> {
     pub(super) lattice: Lattice<D>,
-    covering: [i32; D],
-    criterion_r2: f64,
+    ladder: Vec<Level<D>>,
+    /// Per level: the squared circumradius below which every cell allows that level.
+    criterion_r2: Vec<f64>,
 }
+
+/// The 2D flat torus.
+pub type FlatTorus2 = FlatTorus<2>;
 
 /// The 3D flat torus.
 pub type FlatTorus3 = FlatTorus<3>;
@@ -48,17 +53,45 @@ fn unrank<const D: usize>(mut idx: usize, lo: [i32; D], side: [i32; D]) -> [i32;
 }
 
 impl<const D: usize> FlatTorus<D> {
-    /// The torus of a lattice.
+    /// The torus of a lattice, with the covering ladder of the dimension: halving
+    /// (16/8/4/2/1 sheets for a square) in 2D, the thesis's single covering (27 sheets for a
+    /// cube) in 3D.
     pub fn new(lattice: Lattice<D>) -> Self {
-        let covering = lattice.covering();
-        // Cells with circumradius < δ/4 satisfy Δ < δ/2; keep a relative margin far above the
-        // rounding error of the approximate circumradius.
-        let r = lattice.systole() / 4.0 * (1.0 - 1e-7);
+        let kind = if D == 2 {
+            Ladder::Halving
+        } else {
+            Ladder::Grid
+        };
+        Self::with_ladder(lattice, kind)
+    }
+
+    /// The torus of a lattice with a chosen covering ladder.
+    pub fn with_ladder(lattice: Lattice<D>, kind: Ladder) -> Self {
+        let ladder = lattice.ladder(kind);
+        // Cells with circumradius < δ(H)/4 satisfy Δ < δ(H)/2; keep a relative margin far
+        // above the rounding error of the approximate circumradius. Level 0 needs no test.
+        let criterion_r2 = ladder
+            .iter()
+            .enumerate()
+            .map(|(k, l)| {
+                let r = l.systole / 4.0 * (1.0 - 1e-7);
+                if k == 0 {
+                    f64::INFINITY
+                } else {
+                    r * r
+                }
+            })
+            .collect();
         FlatTorus {
             lattice,
-            covering,
-            criterion_r2: r * r,
+            ladder,
+            criterion_r2,
         }
+    }
+
+    /// The coverings of the ladder, from level 0 (most sheets) to the torus.
+    pub fn ladder(&self) -> &[Level<D>] {
+        &self.ladder
     }
 
     /// The torus of an axis-aligned box `[0,l_0) × … × [0,l_{D−1})`.
@@ -208,49 +241,32 @@ impl<const D: usize> FlatTorus<D> {
         self.compare_lifted(a, b) == Sign::Zero
     }
 
-    pub(super) fn criterion_r2(&self) -> f64 {
-        self.criterion_r2
+    pub(super) fn criterion_r2(&self, level: usize) -> f64 {
+        self.criterion_r2[level]
     }
 
-    pub(super) fn copies(&self) -> Vec<[i8; D]> {
-        (0..self.sheet_count())
-            .map(|k| unrank(k, [0; D], self.covering).map(|x| x as i8))
+    pub(super) fn copies(&self, level: usize) -> Vec<[i8; D]> {
+        self.ladder[level]
+            .sub
+            .copies()
+            .into_iter()
+            .map(|o| o.map(|x| x as i8))
             .collect()
     }
 
-    /// Translates the offsets of a cell by the group of the triangulated space so that their
-    /// componentwise minimum lies in `[0, h)` (covering) or is 0 (quotient).
+    /// Translates the offsets of a cell by the group of the level's space into canonical form.
     #[inline]
-    pub(super) fn normalize_offsets<const N: usize>(
-        &self,
-        off: &mut [[i8; D]; N],
-        one_sheeted: bool,
-    ) {
-        for c in 0..D {
-            let min = off.iter().map(|o| o[c]).min().unwrap();
-            let shift = if one_sheeted {
-                min
-            } else {
-                let h = self.covering[c] as i8;
-                min.div_euclid(h) * h
-            };
-            if shift != 0 {
-                for o in off.iter_mut() {
-                    o[c] -= shift;
-                }
-            }
-        }
+    pub(super) fn normalize_offsets<const N: usize>(&self, off: &mut [[i8; D]; N], level: usize) {
+        self.ladder[level].sub.normalize(off)
     }
 
-    pub(super) fn sheet_count(&self) -> usize {
-        self.covering.iter().map(|&h| h as usize).product()
+    pub(super) fn sheet_count(&self, level: usize) -> usize {
+        self.ladder[level].sub.index()
     }
 
     #[inline]
-    pub(super) fn sheet(&self, o: [i8; D]) -> usize {
-        (0..D).fold(0, |acc, c| {
-            acc * self.covering[c] as usize + (o[c] as i32).rem_euclid(self.covering[c]) as usize
-        })
+    pub(super) fn sheet(&self, o: [i8; D], level: usize) -> usize {
+        self.ladder[level].sub.sheet(widen(o))
     }
 
     /// Every lifted copy of `pts` within `radius` of the lifted point `z` (generously).
@@ -290,10 +306,10 @@ impl<const D: usize> FlatTorus<D> {
         }
     }
 
-    pub(super) fn edge_bound_of(&self, one_sheeted: bool) -> f64 {
-        if one_sheeted {
-            // circumradius < δ/4 ⇒ edges < δ/2
-            self.lattice.systole() / 2.0
+    pub(super) fn edge_bound_of(&self, level: usize) -> f64 {
+        if level > 0 {
+            // circumradius < δ(H)/4 ⇒ edges < δ(H)/2
+            self.ladder[level].systole / 2.0
         } else {
             // largest empty ball of one point: diameter ≤ √(Σ|b_i|²)
             self.lattice
@@ -331,30 +347,34 @@ macro_rules! flat_torus_plugin {
             self.coincide_lifted(a, b)
         }
 
-        fn criterion_radius2(&self) -> f64 {
-            self.criterion_r2()
+        fn levels(&self) -> usize {
+            self.ladder().len()
+        }
+
+        fn criterion_radius2(&self, level: usize) -> f64 {
+            self.criterion_r2(level)
         }
 
         fn single_lift_radius2(&self) -> f64 {
-            4.0 * self.criterion_r2()
+            4.0 * self.criterion_r2(self.ladder().len() - 1)
         }
 
-        fn covering_copies(&self) -> Vec<Self::Offset> {
-            self.copies()
-        }
-
-        #[inline]
-        fn normalize(&self, off: &mut [Self::Offset; $n], one_sheeted: bool) {
-            self.normalize_offsets(off, one_sheeted)
-        }
-
-        fn sheets(&self) -> usize {
-            self.sheet_count()
+        fn covering_copies(&self, level: usize) -> Vec<Self::Offset> {
+            self.copies(level)
         }
 
         #[inline]
-        fn sheet_of(&self, o: Self::Offset) -> usize {
-            self.sheet(o)
+        fn normalize(&self, off: &mut [Self::Offset; $n], level: usize) {
+            self.normalize_offsets(off, level)
+        }
+
+        fn sheets(&self, level: usize) -> usize {
+            self.sheet_count(level)
+        }
+
+        #[inline]
+        fn sheet_of(&self, o: Self::Offset, level: usize) -> usize {
+            self.sheet(o, level)
         }
 
         fn near(
@@ -367,8 +387,8 @@ macro_rules! flat_torus_plugin {
             self.near_copies(z, pts, radius, out)
         }
 
-        fn edge_bound(&self, one_sheeted: bool) -> f64 {
-            self.edge_bound_of(one_sheeted)
+        fn edge_bound(&self, level: usize) -> f64 {
+            self.edge_bound_of(level)
         }
 
         fn dummy_points(&self) -> Vec<Self::Point> {

@@ -205,11 +205,12 @@ mod tests {
         let s = corner_tetrahedron();
         assert!((t.circumradius2(&s) - 0.1875).abs() < 1e-15);
         let mut off = [[1i8, 2, 0], [1, 1, 0], [2, 1, 1], [1, 1, 0]];
-        t.normalize(&mut off, true);
+        t.normalize(&mut off, 1);
         assert_eq!(off, [[0, 1, 0], [0, 0, 0], [1, 0, 1], [0, 0, 0]]);
         let mut off = [[4i8, -1, 0], [3, 0, 0], [4, 0, 1], [3, 0, 0]];
-        t.normalize(&mut off, false);
+        t.normalize(&mut off, 0);
         assert_eq!(off, [[1, 2, 0], [0, 3, 0], [1, 3, 1], [0, 3, 0]]);
-        assert_eq!(t.covering_copies().len(), 27);
+        assert_eq!(t.covering_copies(0).len(), 27);
+        assert_eq!(t.levels(), 2);
     }
 }

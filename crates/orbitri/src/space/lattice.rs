@@ -2,8 +2,39 @@
 //! wrapping into the half-open domain, the systole, and the choice of covering space and
 //! dummy point set that Algorithm 2.3.1 needs for an arbitrary lattice.
 
+use super::sublattice::Sublattice;
 use crate::error::{Error, Result};
 use crate::predicates::filter::Rows;
+
+/// How the covering spaces of a flat torus are chosen.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Ladder {
+    /// One covering of `h_i` copies per lattice vector, then the torus: the thesis's
+    /// Algorithm 2.3.1 (27 sheets for a cube, 9 for a square).
+    Grid,
+    /// Sublattices of index `2^k`, each of index 2 in the next (Bogdanov–Teillaud–Vegter,
+    /// EuroCG 2012), descended one step whenever the next step's criterion holds: 16 (one
+    /// point only), 8, 4, 2 and 1 sheets for a square. Each step keeps the sublattice of index
+    /// 2 with the longest shortest vector.
+    #[default]
+    Halving,
+}
+
+/// One covering of a ladder: its group of translations (in lattice units) and that group's
+/// systole (its shortest translation).
+///
+/// Why each level is safe (Proposition 5 of Bogdanov–Teillaud–Vegter, which holds for any
+/// sublattice `H` of any lattice `G`: its proof applies Corollary 9 of Caroli–Teillaud to
+/// the group `H` acting on `G·S`): if the largest empty ball of `G·S` has diameter
+/// `Δ < δ(H)/2`, the projection of `DT(G·S')` to `E^D/H` is a triangulation for every
+/// `S' ⊇ S`. The engine moves to a level when every circumradius is below `δ(H)/4`, i.e.
+/// `Δ < δ(H)/2`, and never goes back up while points are added. Level 0 needs no test:
+/// its systole exceeds twice the largest empty ball one point can leave.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Level<const D: usize> {
+    pub sub: Sublattice<D>,
+    pub systole: f64,
+}
 
 /// Largest accepted orthogonality defect `Π|b_i| / |det|`. Within it, the coefficients of a
 /// shortest lattice vector are bounded by the defect, so enumerating `|x_i| ≤ 4` finds it.
@@ -80,7 +111,7 @@ impl<const D: usize> Lattice<D> {
             });
         }
         let rows = Rows { m, diagonal };
-        let systole = shortest_vector(&rows, [1; D]);
+        let systole = shortest_vector(&rows, &diagonal_basis([1; D]));
         let lattice = Lattice {
             rows,
             inv,
@@ -197,11 +228,11 @@ impl<const D: usize> Lattice<D> {
         if self.rows.diagonal && (0..D).all(|i| self.rows.m[i][i] == l0) {
             return [3; D];
         }
-        let big = 2.0 * self.rows.m.iter().map(|r| dot(r, r)).sum::<f64>().sqrt() * (1.0 + 1e-9);
+        let big = self.one_point_need();
         // start below the answer and grow the copies along the currently shortest vector
         let mut h: [i32; D] =
             std::array::from_fn(|i| ((big / norm(&self.rows.m[i])).floor() as i32).max(1));
-        while shortest_vector(&self.rows, h) <= big {
+        while shortest_vector(&self.rows, &diagonal_basis(h)) <= big {
             let i = (0..D).min_by(|&a, &b| {
                 let la = h[a] as f64 * norm(&self.rows.m[a]);
                 let lb = h[b] as f64 * norm(&self.rows.m[b]);
@@ -210,6 +241,78 @@ impl<const D: usize> Lattice<D> {
             h[i.unwrap()] += 1;
         }
         h
+    }
+
+    /// Twice the largest empty-ball diameter one point's orbit can leave, bounded by
+    /// `√(Σ|b_i|²)` (covering radius ≤ ½√(Σ|b_i|²)), with a relative margin: a covering whose
+    /// systole exceeds it triangulates every non-empty point set.
+    fn one_point_need(&self) -> f64 {
+        2.0 * self.rows.m.iter().map(|r| dot(r, r)).sum::<f64>().sqrt() * (1.0 + 1e-9)
+    }
+
+    /// The coverings a triangulation passes through on its way to the torus: level 0
+    /// triangulates any non-empty point set, each next level has fewer sheets, the last is the
+    /// torus itself (`Z^D`). [`Ladder::Halving`] falls back to [`Ladder::Grid`] when its
+    /// offsets would not fit the 8-bit range.
+    pub fn ladder(&self, kind: Ladder) -> Vec<Level<D>> {
+        let identity = Level {
+            sub: Sublattice::identity(),
+            systole: self.systole,
+        };
+        let grid = || {
+            let h = self.covering();
+            vec![
+                Level {
+                    sub: Sublattice::diagonal(h),
+                    systole: shortest_vector(&self.rows, &diagonal_basis(h)),
+                },
+                identity.clone(),
+            ]
+        };
+        if kind == Ladder::Grid {
+            return grid();
+        }
+        let need = self.one_point_need();
+        let mut chain = vec![identity.clone()];
+        let mut basis = diagonal_basis([1; D]);
+        while chain.last().unwrap().systole <= need {
+            if chain.len() > 2 * D * 6 {
+                return grid();
+            }
+            // among the 2^D − 1 sublattices of index 2, the one with the longest shortest vector
+            let (best, systole) = (1..1usize << D)
+                .map(|phi| {
+                    let b = reduce_basis(&self.rows, index_two(&basis, phi));
+                    (b, shortest_vector(&self.rows, &b))
+                })
+                .fold(None, |acc: Option<([[i32; D]; D], f64)>, cand| match acc {
+                    Some(a) if a.1 >= cand.1 => Some(a),
+                    _ => Some(cand),
+                })
+                .unwrap();
+            basis = best;
+            chain.push(Level {
+                sub: Sublattice::new(best),
+                systole,
+            });
+        }
+        if chain
+            .iter()
+            .any(|l| (0..D).any(|c| l.sub.span(c) > MAX_COPIES))
+        {
+            return grid();
+        }
+        chain.reverse();
+        // a level no longer than the next one is entered only together with it: skip it
+        let mut k = 1;
+        while k + 1 < chain.len() {
+            if chain[k].systole <= chain[k + 1].systole * (1.0 + 1e-12) {
+                chain.remove(k);
+            } else {
+                k += 1;
+            }
+        }
+        chain
     }
 
     /// A jittered grid of `Π k_i` dummy points in fractional coordinates whose largest empty
@@ -240,6 +343,25 @@ impl<const D: usize> Lattice<D> {
     }
 }
 
+/// The sublattice of index 2 of the lattice spanned by `basis`: the kernel of
+/// `x ↦ φ·x mod 2` for the non-zero parity vector `phi` (a bit per generator).
+fn index_two<const D: usize>(basis: &[[i32; D]; D], phi: usize) -> [[i32; D]; D] {
+    let j = phi.trailing_zeros() as usize;
+    std::array::from_fn(|i| {
+        if i == j {
+            basis[j].map(|x| 2 * x)
+        } else if phi >> i & 1 == 1 {
+            std::array::from_fn(|c| basis[i][c] + basis[j][c])
+        } else {
+            basis[i]
+        }
+    })
+}
+
+fn diagonal_basis<const D: usize>(h: [i32; D]) -> [[i32; D]; D] {
+    std::array::from_fn(|i| std::array::from_fn(|j| if i == j { h[i] } else { 0 }))
+}
+
 fn dot<const D: usize>(a: &[f64; D], b: &[f64; D]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
@@ -248,9 +370,23 @@ fn norm<const D: usize>(a: &[f64; D]) -> f64 {
     dot(a, a).sqrt()
 }
 
-/// Shortest non-zero vector of the lattice spanned by `h_i·b_i` (enumeration, exact for
+/// The Cartesian vectors `basis·M` of a sublattice given in lattice units.
+fn cartesian_basis<const D: usize>(rows: &Rows<D>, basis: &[[i32; D]; D]) -> [[f64; D]; D] {
+    std::array::from_fn(|k| {
+        let mut v = [0.0; D];
+        for j in 0..D {
+            for c in 0..D {
+                v[c] += basis[k][j] as f64 * rows.m[j][c];
+            }
+        }
+        v
+    })
+}
+
+/// Shortest non-zero vector of the sublattice spanned by `basis·M` (enumeration, exact for
 /// bases with orthogonality defect at most [`MAX_DEFECT`]).
-fn shortest_vector<const D: usize>(rows: &Rows<D>, h: [i32; D]) -> f64 {
+fn shortest_vector<const D: usize>(rows: &Rows<D>, basis: &[[i32; D]; D]) -> f64 {
+    let b = cartesian_basis(rows, basis);
     let side = (2 * ENUM + 1) as usize;
     let total = side.pow(D as u32);
     let mut best = f64::INFINITY;
@@ -267,12 +403,40 @@ fn shortest_vector<const D: usize>(rows: &Rows<D>, h: [i32; D]) -> f64 {
         let mut v = [0.0; D];
         for k in 0..D {
             for c in 0..D {
-                v[c] += (t[k] * h[k]) as f64 * rows.m[k][c];
+                v[c] += t[k] as f64 * b[k][c];
             }
         }
         best = best.min(norm(&v));
     }
     best
+}
+
+/// Reduces an integer basis for the Cartesian metric by pairwise Lagrange steps (Lagrange's
+/// algorithm in 2D), so that enumeration finds its shortest vector.
+fn reduce_basis<const D: usize>(rows: &Rows<D>, mut basis: [[i32; D]; D]) -> [[i32; D]; D] {
+    loop {
+        let mut changed = false;
+        for i in 0..D {
+            for j in 0..D {
+                if i == j {
+                    continue;
+                }
+                let b = cartesian_basis(rows, &basis);
+                let mu = (dot(&b[i], &b[j]) / dot(&b[i], &b[i])).round();
+                let shorter: [f64; D] = std::array::from_fn(|c| b[j][c] - mu * b[i][c]);
+                // strictly shorter only: the loop ends on a discrete lattice
+                if mu != 0.0 && dot(&shorter, &shorter) < dot(&b[j], &b[j]) * (1.0 - 1e-12) {
+                    for c in 0..D {
+                        basis[j][c] -= mu as i32 * basis[i][c];
+                    }
+                    changed = true;
+                }
+            }
+        }
+        if !changed {
+            return basis;
+        }
+    }
 }
 
 /// Determinant and inverse by Gauss–Jordan elimination with partial pivoting.

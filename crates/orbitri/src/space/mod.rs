@@ -5,9 +5,11 @@ mod flat_torus;
 mod flat_torus2;
 mod flat_torus3;
 mod lattice;
+mod sublattice;
 
-pub use flat_torus::{FlatTorus, FlatTorus3, Offset3};
-pub use lattice::{Lattice, MAX_COPIES, MAX_DEFECT};
+pub use flat_torus::{FlatTorus, FlatTorus2, FlatTorus3, Offset3};
+pub use lattice::{Ladder, Lattice, Level, MAX_COPIES, MAX_DEFECT};
+pub use sublattice::Sublattice;
 
 use crate::predicates::Sign;
 use std::fmt::Debug;
@@ -47,23 +49,28 @@ pub trait OrbitSpace<const N: usize>: Sync + Send {
     ) -> bool;
     /// Approximate squared circumradius (infinite for a flat simplex).
     fn circumradius2(&self, s: &[Lifted<Self::Point, Self::Offset>; N]) -> f64;
-    /// Squared circumradius below which every cell is safe for the 1-sheeted quotient
-    /// (Corollary 9 of Caroli–Teillaud: `Δ < δ/2`, i.e. radius `< δ/4`), with a safety margin.
-    fn criterion_radius2(&self) -> f64;
+    /// Number of levels of the covering ladder: level 0 is a covering in which every
+    /// non-empty point set has a Delaunay triangulation, each next level has fewer sheets, and
+    /// the last is the orbit space itself (1 sheet).
+    fn levels(&self) -> usize;
+    /// Squared circumradius below which every cell allows `level`: then the level's space
+    /// is triangulated for this point set and every superset (Corollary 9 of Caroli–Teillaud,
+    /// `Δ < δ(H)/2`, i.e. radius `< δ(H)/4`), with a safety margin. Infinite for level 0.
+    fn criterion_radius2(&self, level: usize) -> f64;
     /// Squared radius below which a ball holds at most one lift of any point (`δ/2`), with
     /// a safety margin: a conflict region made of such balls lifts consistently.
     fn single_lift_radius2(&self) -> f64;
-    /// The offsets of the copies of one point in the initial covering space (one per sheet).
-    fn covering_copies(&self) -> Vec<Self::Offset>;
-    /// Translates a cell's offsets by a group element of the triangulated space (the covering
-    /// lattice, or the lattice itself once 1-sheeted) into canonical form.
-    fn normalize(&self, off: &mut [Self::Offset; N], one_sheeted: bool);
+    /// The offsets of the copies of one point in the covering of `level` (one per sheet).
+    fn covering_copies(&self, level: usize) -> Vec<Self::Offset>;
+    /// Translates a cell's offsets by a group element of the space of `level` into canonical
+    /// form: cells that differ by such a translation get equal offsets.
+    fn normalize(&self, off: &mut [Self::Offset; N], level: usize);
     /// A dummy point set whose Delaunay triangulation satisfies the switch criterion.
     fn dummy_points(&self) -> Vec<Self::Point>;
-    /// Number of sheets of the initial covering (`covering_copies().len()`).
-    fn sheets(&self) -> usize;
-    /// Index of the sheet holding a lifted copy with offset `o` (in `0..sheets()`).
-    fn sheet_of(&self, o: Self::Offset) -> usize;
+    /// Number of sheets of the covering of `level` (`covering_copies(level).len()`).
+    fn sheets(&self, level: usize) -> usize;
+    /// Index of the sheet of `level` holding a lifted copy with offset `o`.
+    fn sheet_of(&self, o: Self::Offset, level: usize) -> usize;
     /// Appends to `out` every lifted copy `(i, o)` of `pts[i]` whose position is within
     /// `radius` of the lifted point `z` (generous: a copy slightly farther may be included).
     fn near(
@@ -73,10 +80,9 @@ pub trait OrbitSpace<const N: usize>: Sync + Send {
         radius: f64,
         out: &mut Vec<(u32, Self::Offset)>,
     );
-    /// An upper bound on the length of a Delaunay edge: in the initial covering (for any
-    /// non-empty point set) when `one_sheeted` is false, and under the switch criterion when
-    /// it is true.
-    fn edge_bound(&self, one_sheeted: bool) -> f64;
+    /// An upper bound on the length of a Delaunay edge: at level 0 for any non-empty point
+    /// set, at a later level under that level's criterion.
+    fn edge_bound(&self, level: usize) -> f64;
     /// A key along a space-filling curve, for spatial sorting.
     fn spatial_key(&self, p: &Self::Point) -> u64;
 }
