@@ -3,20 +3,24 @@
 mod rss;
 
 use std::io::{BufWriter, IsTerminal, Write};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
+use orbitri::io::SvgOptions;
+use orbitri::periodic::Torus;
 use orbitri::sort::SplitMix;
-use orbitri::{BuildOptions, FlatTorus3, PeriodicDelaunay3};
+use orbitri::{
+    BuildOptions, FlatTorus, FlatTorus2, FlatTorus3, PeriodicDelaunay, PeriodicDelaunay2,
+};
 
 #[derive(Parser)]
 #[command(
     name = "orbitri",
     version,
-    about = "Exact periodic Delaunay triangulations (flat tori with any lattice)"
+    about = "Exact periodic Delaunay triangulations (2D and 3D flat tori with any lattice)"
 )]
 struct Cli {
     #[command(subcommand)]
@@ -25,8 +29,9 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Triangulate the points of INPUT (text: one `x y z` per line, `#` comments, commas or
-    /// blanks; or `.npy`: float64, N×3) in a periodic box or lattice.
+    /// Triangulate the points of INPUT (text: one `x y z` or `x y` per line, `#` comments,
+    /// commas or blanks; or `.npy`: float64, N×3 or N×2) in a periodic box or lattice; the
+    /// dimension is that of the box.
     Triangulate {
         /// Input file (text or .npy)
         input: PathBuf,
@@ -35,8 +40,32 @@ enum Command {
         #[command(flatten)]
         out: Output,
     },
-    /// Triangulate a built-in example: uniform random points in the unit cube and an FCC
-    /// crystal (every Delaunay sphere degenerate), with exact validity checks.
+    /// Draw the periodic Delaunay triangulation and Voronoi diagram of 2D points over copies
+    /// of the domain, to SVG (or PNG for a `.png` output name).
+    Draw {
+        /// Input file (text or .npy, 2 coordinates per point)
+        input: PathBuf,
+        #[command(flatten)]
+        domain: Domain,
+        /// Output file: .svg or .png
+        #[arg(short = 'o', long)]
+        output: PathBuf,
+        /// Copies of the domain per lattice direction
+        #[arg(long, default_value_t = 3)]
+        copies: u32,
+        /// Picture width in pixels
+        #[arg(long, default_value_t = 800.0)]
+        width: f64,
+        /// Leave out the Voronoi diagram
+        #[arg(long)]
+        no_voronoi: bool,
+        /// Leave out the Delaunay edges
+        #[arg(long)]
+        no_delaunay: bool,
+    },
+    /// Triangulate built-in examples: uniform random points in the unit cube and an FCC
+    /// crystal (every Delaunay sphere degenerate), then the unit square and a hexagonal
+    /// crystal in 2D, with exact validity checks.
     Demo {
         /// Number of random points
         #[arg(short = 'n', long, default_value_t = 100_000)]
@@ -45,11 +74,15 @@ enum Command {
         #[arg(long, default_value_t = 1)]
         seed: u64,
     },
-    /// Write N uniform random points of the unit cube (the CGAL anchor harness's generator).
+    /// Write N uniform random points of the unit cube or square (the CGAL anchor harness's
+    /// generator).
     Generate {
         n: usize,
         #[arg(long, default_value_t = 1)]
         seed: u64,
+        /// Dimension: 3 (unit cube) or 2 (unit square)
+        #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u8).range(2..=3))]
+        dim: u8,
         #[arg(short = 'o', long)]
         output: Option<PathBuf>,
     },
@@ -58,11 +91,12 @@ enum Command {
 #[derive(Args)]
 #[group(required = true, multiple = false)]
 struct Domain {
-    /// Box lengths: the domain is [0,LX) × [0,LY) × [0,LZ)
-    #[arg(long = "box", num_args = 3, value_names = ["LX", "LY", "LZ"], allow_negative_numbers = true)]
+    /// Box lengths: the domain is [0,LX) × [0,LY) × [0,LZ), or [0,LX) × [0,LY) in 2D
+    #[arg(long = "box", num_args = 2..=3, value_names = ["LX", "LY", "LZ"], allow_negative_numbers = true)]
     box_lengths: Option<Vec<f64>>,
-    /// Lattice vectors a, b, c (rows); the domain is {f·M : f ∈ [0,1)³}
-    #[arg(long, num_args = 9, value_names = ["AX", "AY", "AZ", "BX", "BY", "BZ", "CX", "CY", "CZ"], allow_negative_numbers = true)]
+    /// Lattice vectors (rows): AX AY AZ BX BY BZ CX CY CZ in 3D, AX AY BX BY in 2D; the
+    /// domain is {f·M : f ∈ [0,1)^D}
+    #[arg(long, num_args = 4..=9, value_names = ["AX", "AY", "..."], allow_negative_numbers = true)]
     lattice: Option<Vec<f64>>,
 }
 
@@ -81,7 +115,7 @@ struct Output {
 
 #[derive(Clone, Copy, ValueEnum)]
 enum Format {
-    /// `SHEETS V C`, then per cell 4 input ids and 4 offsets (3 integers each)
+    /// `SHEETS V C`, then per cell D+1 input ids and D+1 offsets (D integers each)
     Cells,
     /// JSON with lattice, wrapped points, first occurrences, cells and offsets
     Json,
@@ -98,17 +132,42 @@ enum CliError {
     },
     #[error("{0}")]
     Check(String),
+    #[error("{0}")]
+    Usage(String),
+    #[error("{}: cannot render the PNG: {message}", path.display())]
+    Render { path: PathBuf, message: String },
 }
 
-fn space(domain: &Domain) -> Result<FlatTorus3, orbitri::Error> {
+/// The torus of the command line, of either dimension.
+enum Space {
+    Two(FlatTorus2),
+    Three(FlatTorus3),
+}
+
+fn space(domain: &Domain) -> Result<Space, CliError> {
     if let Some(b) = &domain.box_lengths {
-        FlatTorus3::cuboid([b[0], b[1], b[2]])
-    } else {
-        let l = domain
-            .lattice
-            .as_ref()
-            .expect("clap requires --box or --lattice");
-        FlatTorus3::triclinic([[l[0], l[1], l[2]], [l[3], l[4], l[5]], [l[6], l[7], l[8]]])
+        return Ok(match b.len() {
+            2 => Space::Two(FlatTorus2::cuboid([b[0], b[1]])?),
+            _ => Space::Three(FlatTorus3::cuboid([b[0], b[1], b[2]])?),
+        });
+    }
+    let l = domain
+        .lattice
+        .as_ref()
+        .expect("clap requires --box or --lattice");
+    match l.len() {
+        4 => Ok(Space::Two(FlatTorus2::triclinic([
+            [l[0], l[1]],
+            [l[2], l[3]],
+        ])?)),
+        9 => Ok(Space::Three(FlatTorus3::triclinic([
+            [l[0], l[1], l[2]],
+            [l[3], l[4], l[5]],
+            [l[6], l[7], l[8]],
+        ])?)),
+        n => Err(CliError::Usage(format!(
+            "--lattice takes 4 numbers (2D: AX AY BX BY) or 9 (3D), not {n}"
+        ))),
     }
 }
 
@@ -133,10 +192,16 @@ struct Cost {
     peak_rss_kb: Option<u64>,
 }
 
-fn build(space: FlatTorus3, pts: &[[f64; 3]]) -> Result<(PeriodicDelaunay3, Cost), orbitri::Error> {
+fn build<const D: usize, const N: usize>(
+    space: FlatTorus<D>,
+    pts: &[[f64; D]],
+) -> Result<(PeriodicDelaunay<D, N>, Cost), orbitri::Error>
+where
+    FlatTorus<D>: Torus<D, N>,
+{
     let bar = progress_bar(pts.len());
     let start = Instant::now();
-    let tri = PeriodicDelaunay3::build_with(space, pts, BuildOptions::default(), |k| {
+    let tri = PeriodicDelaunay::build_with(space, pts, BuildOptions::default(), |k| {
         if let Some(b) = &bar {
             b.set_position(k as u64);
         }
@@ -151,7 +216,14 @@ fn build(space: FlatTorus3, pts: &[[f64; 3]]) -> Result<(PeriodicDelaunay3, Cost
     Ok((tri, cost))
 }
 
-fn stats_line(tri: &PeriodicDelaunay3, input: usize, cost: &Cost) -> String {
+fn stats_line<const D: usize, const N: usize>(
+    tri: &PeriodicDelaunay<D, N>,
+    input: usize,
+    cost: &Cost,
+) -> String
+where
+    FlatTorus<D>: Torus<D, N>,
+{
     format!(
         "input={input} vertices={} cells={} sheets={} duplicates={} wrapped={} dummies={} build_seconds={:.6} peak_rss_kb={}",
         tri.number_of_vertices(),
@@ -178,8 +250,21 @@ fn writer(path: &Option<PathBuf>) -> Result<Box<dyn Write>, CliError> {
 }
 
 fn triangulate(input: PathBuf, domain: Domain, out: Output) -> Result<(), CliError> {
-    let space = space(&domain)?;
-    let pts: Vec<[f64; 3]> = orbitri::io::read_points(&input)?;
+    match space(&domain)? {
+        Space::Two(s) => triangulate_in::<2, 3>(s, &input, out),
+        Space::Three(s) => triangulate_in::<3, 4>(s, &input, out),
+    }
+}
+
+fn triangulate_in<const D: usize, const N: usize>(
+    space: FlatTorus<D>,
+    input: &Path,
+    out: Output,
+) -> Result<(), CliError>
+where
+    FlatTorus<D>: Torus<D, N>,
+{
+    let pts: Vec<[f64; D]> = orbitri::io::read_points(input)?;
     let (tri, cost) = build(space, &pts)?;
     let path = out
         .output
@@ -198,9 +283,51 @@ fn triangulate(input: PathBuf, domain: Domain, out: Output) -> Result<(), CliErr
     Ok(())
 }
 
-fn uniform(n: usize, seed: u64) -> Vec<[f64; 3]> {
+fn draw(input: PathBuf, domain: Domain, output: PathBuf, opts: SvgOptions) -> Result<(), CliError> {
+    let Space::Two(space) = space(&domain)? else {
+        return Err(CliError::Usage(
+            "draw renders 2D tori: give --box LX LY or --lattice AX AY BX BY".into(),
+        ));
+    };
+    let pts: Vec<[f64; 2]> = orbitri::io::read_points(&input)?;
+    let (tri, _): (PeriodicDelaunay2, _) = build(space, &pts)?;
+    let mut svg = Vec::new();
+    orbitri::io::write_svg(&mut svg, &tri, &opts).expect("writing to memory");
+    let png = output
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+    let bytes = if png {
+        render_png(&svg).map_err(|message| CliError::Render {
+            path: output.clone(),
+            message,
+        })?
+    } else {
+        svg
+    };
+    std::fs::write(&output, bytes).map_err(|source| CliError::Write {
+        path: output,
+        source,
+    })
+}
+
+/// Rasterizes our SVG (no text, no images) with resvg.
+fn render_png(svg: &[u8]) -> Result<Vec<u8>, String> {
+    let tree = resvg::usvg::Tree::from_data(svg, &resvg::usvg::Options::default())
+        .map_err(|e| e.to_string())?;
+    let size = tree.size().to_int_size();
+    let mut pixmap =
+        resvg::tiny_skia::Pixmap::new(size.width(), size.height()).ok_or("empty picture")?;
+    resvg::render(
+        &tree,
+        resvg::tiny_skia::Transform::default(),
+        &mut pixmap.as_mut(),
+    );
+    pixmap.encode_png().map_err(|e| e.to_string())
+}
+
+fn uniform<const D: usize>(n: usize, seed: u64) -> Vec<[f64; D]> {
     let mut r = SplitMix::new(seed);
-    (0..n).map(|_| [r.unit(), r.unit(), r.unit()]).collect()
+    (0..n).map(|_| std::array::from_fn(|_| r.unit())).collect()
 }
 
 fn demo(n: usize, seed: u64) -> Result<(), CliError> {
@@ -208,8 +335,8 @@ fn demo(n: usize, seed: u64) -> Result<(), CliError> {
     let say = |out: &mut std::io::StdoutLock, s: String| {
         let _ = writeln!(out, "{s}");
     };
-    let pts = uniform(n, seed);
-    let (tri, cost) = build(FlatTorus3::cuboid([1.0; 3])?, &pts)?;
+    let pts = uniform::<3>(n, seed);
+    let (tri, cost) = build::<3, 4>(FlatTorus3::cuboid([1.0; 3])?, &pts)?;
     say(
         &mut out,
         format!("uniform random points in the unit cube (seed {seed}):"),
@@ -253,7 +380,7 @@ fn demo(n: usize, seed: u64) -> Result<(), CliError> {
             }
         }
     }
-    let (tri, cost) = build(FlatTorus3::cuboid([0.6; 3])?, &fcc)?;
+    let (tri, cost) = build::<3, 4>(FlatTorus3::cuboid([0.6; 3])?, &fcc)?;
     say(
         &mut out,
         "FCC crystal, 864 points, all octahedral holes cospherical:".to_string(),
@@ -273,12 +400,18 @@ fn demo(n: usize, seed: u64) -> Result<(), CliError> {
     Ok(())
 }
 
-fn generate(n: usize, seed: u64, output: Option<PathBuf>) -> Result<(), CliError> {
+fn generate(n: usize, seed: u64, dim: u8, output: Option<PathBuf>) -> Result<(), CliError> {
     let path = output.clone().unwrap_or_else(|| PathBuf::from("<stdout>"));
     let mut w = writer(&output)?;
     let res = (|| {
-        for p in uniform(n, seed) {
-            writeln!(w, "{:?} {:?} {:?}", p[0], p[1], p[2])?;
+        if dim == 2 {
+            for p in uniform::<2>(n, seed) {
+                writeln!(w, "{:?} {:?}", p[0], p[1])?;
+            }
+        } else {
+            for p in uniform::<3>(n, seed) {
+                writeln!(w, "{:?} {:?} {:?}", p[0], p[1], p[2])?;
+            }
         }
         w.flush()
     })();
@@ -290,7 +423,32 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Triangulate { input, domain, out } => triangulate(input, domain, out),
         Command::Demo { points, seed } => demo(points, seed),
-        Command::Generate { n, seed, output } => generate(n, seed, output),
+        Command::Draw {
+            input,
+            domain,
+            output,
+            copies,
+            width,
+            no_voronoi,
+            no_delaunay,
+        } => draw(
+            input,
+            domain,
+            output,
+            SvgOptions {
+                copies,
+                width,
+                voronoi: !no_voronoi,
+                delaunay: !no_delaunay,
+                points: true,
+            },
+        ),
+        Command::Generate {
+            n,
+            seed,
+            dim,
+            output,
+        } => generate(n, seed, dim, output),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

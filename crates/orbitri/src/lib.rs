@@ -20,7 +20,7 @@
 pub mod delaunay;
 pub mod error;
 pub mod io;
-pub mod periodic3;
+pub mod periodic;
 pub mod predicates;
 pub mod sort;
 pub mod space;
@@ -28,5 +28,7 @@ pub mod tds;
 
 pub use delaunay::{Engine, Inserted, Invalid};
 pub use error::{Error, Result};
-pub use periodic3::{BuildOptions, CellView, Copies, PeriodicDelaunay3, Simplex};
-pub use space::{FlatTorus3, Lattice, OrbitSpace};
+pub use periodic::{
+    BuildOptions, CellView, Copies, PeriodicDelaunay, PeriodicDelaunay2, PeriodicDelaunay3, Simplex,
+};
+pub use space::{FlatTorus, FlatTorus2, FlatTorus3, Ladder, Lattice, OrbitSpace};

@@ -1,10 +1,12 @@
-//! Readers (points from text or `.npy`) and writers (the `cells` format and JSON).
+//! Readers (points from text or `.npy`) and writers (the `cells` format, JSON and SVG).
 
 mod npy;
+mod svg;
 mod text;
 mod write;
 
 pub use npy::{encode_npy, read_npy};
+pub use svg::{write_svg, SvgOptions};
 pub use text::{parse_text, read_text};
 pub use write::{write_cells, write_json};
 

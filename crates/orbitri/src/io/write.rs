@@ -2,12 +2,20 @@
 
 use std::io::Write;
 
-use crate::periodic3::PeriodicDelaunay3;
+use crate::periodic::{PeriodicDelaunay, Torus};
+use crate::space::FlatTorus;
 
-/// The `cells` format: `SHEETS V C`, then per stored cell the 4 input ids and the 4 offsets
-/// (3 integers each, lattice units), positively oriented. `V` counts distinct points, `C`
-/// the cell lines that follow (in a covering space: every stored copy).
-pub fn write_cells(w: &mut impl Write, tri: &PeriodicDelaunay3) -> std::io::Result<()> {
+/// The `cells` format: `SHEETS V C`, then per stored cell its `D + 1` input ids and their
+/// offsets (`D` integers each, lattice units), positively oriented (counter-clockwise in
+/// 2D). `V` counts distinct points, `C` the cell lines that follow (in a covering space:
+/// every stored copy).
+pub fn write_cells<const D: usize, const N: usize>(
+    w: &mut impl Write,
+    tri: &PeriodicDelaunay<D, N>,
+) -> std::io::Result<()>
+where
+    FlatTorus<D>: Torus<D, N>,
+{
     writeln!(
         w,
         "{} {} {}",
@@ -43,11 +51,20 @@ fn json_f64(x: f64) -> String {
 
 /// JSON: `{"dimension", "sheets", "lattice", "points" (wrapped, input order),
 /// "first_occurrence", "cells", "offsets"}`, written as it is produced.
-pub fn write_json(w: &mut impl Write, tri: &PeriodicDelaunay3) -> std::io::Result<()> {
-    let row = |r: &[f64; 3]| format!("[{},{},{}]", json_f64(r[0]), json_f64(r[1]), json_f64(r[2]));
+pub fn write_json<const D: usize, const N: usize>(
+    w: &mut impl Write,
+    tri: &PeriodicDelaunay<D, N>,
+) -> std::io::Result<()>
+where
+    FlatTorus<D>: Torus<D, N>,
+{
+    let row = |r: &[f64; D]| {
+        let v: Vec<String> = r.iter().map(|&x| json_f64(x)).collect();
+        format!("[{}]", v.join(","))
+    };
     write!(
         w,
-        "{{\"dimension\":3,\"sheets\":{},\"lattice\":[",
+        "{{\"dimension\":{D},\"sheets\":{},\"lattice\":[",
         tri.sheets()
     )?;
     write_list(w, tri.space().lattice().vectors().iter().map(row))?;

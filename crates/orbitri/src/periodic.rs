@@ -1,15 +1,29 @@
-//! `PeriodicDelaunay3`: the Delaunay triangulation of a point set in a 3D flat torus, with
-//! input bookkeeping (wrapping, duplicates), bulk construction and the access API.
+//! `PeriodicDelaunay<D, N>`: the Delaunay triangulation of a point set in a flat torus of
+//! dimension `D` (cells of `N = D + 1` vertices), with input bookkeeping (wrapping,
+//! duplicates), bulk construction and the access API; `PeriodicDelaunay2` and
+//! `PeriodicDelaunay3` name the two dimensions.
 
 use std::collections::HashSet;
 
 use crate::delaunay::{Engine, Inserted, Invalid};
 use crate::error::{Error, Result};
-use crate::space::{FlatTorus3, OrbitSpace};
+use crate::space::{FlatTorus, OrbitSpace};
 use crate::tds::NONE;
 
 /// Offset of a vertex in lattice-vector units.
-pub type Offset = [i8; 3];
+pub type Offset<const D: usize = 3> = [i8; D];
+
+/// The flat tori the facade serves: `FlatTorus<D>` as an orbit space with cells of `N`
+/// vertices, points `[f64; D]` and offsets `[i8; D]`.
+pub trait Torus<const D: usize, const N: usize>:
+    OrbitSpace<N, Point = [f64; D], Offset = [i8; D]> + Clone
+{
+}
+
+impl<const D: usize, const N: usize> Torus<D, N> for FlatTorus<D> where
+    FlatTorus<D>: OrbitSpace<N, Point = [f64; D], Offset = [i8; D]>
+{
+}
 
 /// Which copies an iterator yields in a multi-sheeted covering (CGAL's iterator types).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -20,19 +34,20 @@ pub enum Copies {
     Stored,
 }
 
-/// A cell: input ids of its vertices and their offsets, positively oriented.
+/// A cell: input ids of its vertices and their offsets, positively oriented
+/// (counter-clockwise in 2D).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct CellView {
-    pub vertices: [u32; 4],
-    pub offsets: [Offset; 4],
+pub struct CellView<const D: usize = 3, const N: usize = 4> {
+    pub vertices: [u32; N],
+    pub offsets: [Offset<D>; N],
 }
 
-/// A simplex of lower dimension (edge: 2 vertices, facet: 3), canonical: sorted by
-/// (vertex, offset) with the first offset translated to zero.
+/// A simplex of lower dimension (edge: 2 vertices, facet: `D`), canonical: sorted by
+/// (vertex, offset) with the componentwise minimum offset translated to zero.
 #[derive(Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct Simplex {
+pub struct Simplex<const D: usize = 3> {
     pub vertices: Vec<u32>,
-    pub offsets: Vec<Offset>,
+    pub offsets: Vec<Offset<D>>,
 }
 
 /// Options of the bulk construction.
@@ -56,10 +71,13 @@ impl Default for BuildOptions {
     }
 }
 
-/// The periodic Delaunay triangulation of a 3D flat torus.
+/// The periodic Delaunay triangulation of a flat torus of dimension `D`.
 #[derive(Debug)]
-pub struct PeriodicDelaunay3 {
-    engine: Engine<FlatTorus3, 4>,
+pub struct PeriodicDelaunay<const D: usize, const N: usize>
+where
+    FlatTorus<D>: Torus<D, N>,
+{
+    engine: Engine<FlatTorus<D>, N>,
     /// Input index → point (vertex) index.
     input_point: Vec<u32>,
     /// Point index → input index of its first occurrence.
@@ -69,7 +87,12 @@ pub struct PeriodicDelaunay3 {
     used_dummies: bool,
 }
 
-fn check_finite(i: usize, p: &[f64; 3]) -> Result<()> {
+/// The periodic Delaunay triangulation of a 2D flat torus.
+pub type PeriodicDelaunay2 = PeriodicDelaunay<2, 3>;
+/// The periodic Delaunay triangulation of a 3D flat torus.
+pub type PeriodicDelaunay3 = PeriodicDelaunay<3, 4>;
+
+fn check_finite<const D: usize>(i: usize, p: &[f64; D]) -> Result<()> {
     for (axis, v) in p.iter().enumerate() {
         if !v.is_finite() {
             return Err(Error::NonFiniteCoordinate {
@@ -82,10 +105,13 @@ fn check_finite(i: usize, p: &[f64; 3]) -> Result<()> {
     Ok(())
 }
 
-impl PeriodicDelaunay3 {
+impl<const D: usize, const N: usize> PeriodicDelaunay<D, N>
+where
+    FlatTorus<D>: Torus<D, N>,
+{
     /// An empty triangulation of the torus.
-    pub fn new(space: FlatTorus3) -> Self {
-        PeriodicDelaunay3 {
+    pub fn new(space: FlatTorus<D>) -> Self {
+        PeriodicDelaunay {
             engine: Engine::new(space),
             input_point: Vec::new(),
             point_input: Vec::new(),
@@ -96,7 +122,7 @@ impl PeriodicDelaunay3 {
     }
 
     /// Builds the triangulation of `points` (wrapped into the domain first).
-    pub fn build(space: FlatTorus3, points: &[[f64; 3]]) -> Result<Self> {
+    pub fn build(space: FlatTorus<D>, points: &[[f64; D]]) -> Result<Self> {
         Self::build_with(space, points, BuildOptions::default(), |_| {})
     }
 
@@ -105,8 +131,8 @@ impl PeriodicDelaunay3 {
     /// (or if removing a dummy would break the criterion) insert into the covering space.
     /// `progress` is called with the number of points inserted so far.
     pub fn build_with(
-        space: FlatTorus3,
-        points: &[[f64; 3]],
+        space: FlatTorus<D>,
+        points: &[[f64; D]],
         opts: BuildOptions,
         progress: impl Fn(usize),
     ) -> Result<Self> {
@@ -127,18 +153,20 @@ impl PeriodicDelaunay3 {
         } else {
             (0..points.len() as u32).collect()
         };
-        let mut tri = PeriodicDelaunay3::new(space.clone());
+        let mut tri = Self::new(space.clone());
         tri.wrapped = wrapped;
-        // a 3D Delaunay triangulation of uniform points has about 6.77 cells per vertex
+        // a Delaunay triangulation of uniform points has about 6.77 cells per vertex in 3D,
+        // exactly 2 in 2D
+        let per_point = if D == 3 { 27 } else { 8 };
         tri.engine
-            .reserve(points.len() + 128, points.len() * 27 / 4 + 4096);
+            .reserve(points.len() + 128, points.len() * per_point / 4 + 4096);
         if points.len() >= opts.dummy_threshold
             && tri.build_from_dummies(&wrapped_pts, &order, &progress)
         {
             tri.represent_first_occurrences(&wrapped_pts);
             return Ok(tri);
         }
-        let mut tri = PeriodicDelaunay3::new(space);
+        let mut tri = Self::new(space);
         tri.wrapped = wrapped;
         tri.input_point = vec![NONE; points.len()];
         for (k, &i) in order.iter().enumerate() {
@@ -159,7 +187,7 @@ impl PeriodicDelaunay3 {
     /// coordinates of its first occurrence, as the output formats promise (offsets are
     /// relative to input `i`'s wrapped point). Duplicates can differ from it by an exact
     /// lattice translation, which the offsets of the point's star absorb.
-    fn represent_first_occurrences(&mut self, wrapped: &[[f64; 3]]) {
+    fn represent_first_occurrences(&mut self, wrapped: &[[f64; D]]) {
         for p in 0..self.point_input.len() {
             let want = wrapped[self.point_input[p] as usize];
             let have = self.engine.points()[p];
@@ -167,13 +195,13 @@ impl PeriodicDelaunay3 {
                 continue;
             }
             // want + t·M == have for an integer t: found approximately, confirmed exactly
-            let d: [f64; 3] = std::array::from_fn(|c| have[c] - want[c]);
+            let d: [f64; D] = std::array::from_fn(|c| have[c] - want[c]);
             let t = self
                 .space()
                 .lattice()
                 .fractional(&d)
                 .map(|x| x.round() as i8);
-            let exact = self.space().coincide((want, t), (have, [0; 3]));
+            let exact = self.space().coincide((want, t), (have, [0; D]));
             debug_assert!(exact, "a duplicate is an exact lattice translate");
             if exact {
                 self.engine.move_representative(p as u32, want, t);
@@ -185,7 +213,7 @@ impl PeriodicDelaunay3 {
     /// dummy, or the points alone do not satisfy the criterion).
     fn build_from_dummies(
         &mut self,
-        pts: &[[f64; 3]],
+        pts: &[[f64; D]],
         order: &[u32],
         progress: &impl Fn(usize),
     ) -> bool {
@@ -224,7 +252,7 @@ impl PeriodicDelaunay3 {
         true
     }
 
-    fn insert_wrapped(&mut self, i: usize, p: [f64; 3]) -> Inserted {
+    fn insert_wrapped(&mut self, i: usize, p: [f64; D]) -> Inserted {
         let r = self.engine.insert(p);
         match r {
             Inserted::New(v) => {
@@ -246,7 +274,7 @@ impl PeriodicDelaunay3 {
 
     /// Inserts one more point (wrapped into the domain); its input id is the number of
     /// points given so far. Returns the vertex (point index) it became or coincides with.
-    pub fn insert(&mut self, p: [f64; 3]) -> Result<Inserted> {
+    pub fn insert(&mut self, p: [f64; D]) -> Result<Inserted> {
         let i = self.input_point.len();
         check_finite(i, &p)?;
         let (w, moved) = self.engine.space().lattice().wrap(p);
@@ -256,12 +284,12 @@ impl PeriodicDelaunay3 {
     }
 
     /// The orbit space.
-    pub fn space(&self) -> &FlatTorus3 {
+    pub fn space(&self) -> &FlatTorus<D> {
         self.engine.space()
     }
 
     /// The engine (for generic algorithms).
-    pub fn engine(&self) -> &Engine<FlatTorus3, 4> {
+    pub fn engine(&self) -> &Engine<FlatTorus<D>, N> {
         &self.engine
     }
 
@@ -306,7 +334,7 @@ impl PeriodicDelaunay3 {
     }
 
     /// The distinct points (wrapped), indexed by vertex.
-    pub fn points(&self) -> &[[f64; 3]] {
+    pub fn points(&self) -> &[[f64; D]] {
         self.engine.points()
     }
 
@@ -328,9 +356,9 @@ impl PeriodicDelaunay3 {
             .collect()
     }
 
-    fn view(&self, c: u32) -> CellView {
+    fn view(&self, c: u32) -> CellView<D, N> {
         let cell = self.engine.cell(c);
-        CellView {
+        CellView::<D, N> {
             vertices: cell
                 .v
                 .map(|x| self.point_input[self.engine.point_of(x) as usize]),
@@ -339,12 +367,12 @@ impl PeriodicDelaunay3 {
     }
 
     /// Every stored cell, lazily (for writers of large triangulations).
-    pub fn stored_cells(&self) -> impl Iterator<Item = CellView> + '_ {
+    pub fn stored_cells(&self) -> impl Iterator<Item = CellView<D, N>> + '_ {
         self.engine.cell_ids().map(|c| self.view(c))
     }
 
     /// The cells with input ids and offsets: every stored cell, or one per orbit.
-    pub fn cells(&self, copies: Copies) -> Vec<CellView> {
+    pub fn cells(&self, copies: Copies) -> Vec<CellView<D, N>> {
         if copies == Copies::Stored || self.is_one_sheeted() {
             return self.stored_cells().collect();
         }
@@ -356,28 +384,28 @@ impl PeriodicDelaunay3 {
 
     /// A face of a stored cell (the slots in `idx`): its vertices as input ids (`Unique`)
     /// or stored vertex ids (`Stored`), in canonical form.
-    fn face(&self, c: u32, idx: &[usize], copies: Copies) -> Simplex {
+    fn face(&self, c: u32, idx: &[usize], copies: Copies) -> Simplex<D> {
         let cell = self.engine.cell(c);
         let id = |x: u32| match copies {
             Copies::Unique => self.point_input[self.engine.point_of(x) as usize],
             Copies::Stored => x,
         };
         let v: Vec<u32> = idx.iter().map(|&i| id(cell.v[i])).collect();
-        let o: Vec<Offset> = idx.iter().map(|&i| cell.off[i]).collect();
+        let o: Vec<Offset<D>> = idx.iter().map(|&i| cell.off[i]).collect();
         let (vertices, offsets) = canonical(&v, &o);
         Simplex { vertices, offsets }
     }
 
     /// In a covering space, one copy per orbit of faces (canonical forms deduplicated).
-    fn unique_in_covering(&self, faces: impl Iterator<Item = Simplex>) -> Vec<Simplex> {
-        let mut out: Vec<Simplex> = faces.collect::<HashSet<_>>().into_iter().collect();
+    fn unique_in_covering(&self, faces: impl Iterator<Item = Simplex<D>>) -> Vec<Simplex<D>> {
+        let mut out: Vec<Simplex<D>> = faces.collect::<HashSet<_>>().into_iter().collect();
         out.sort_unstable();
         out
     }
 
     /// The edges (input ids, offsets), each once; `Stored` lists covering copies by vertex
     /// id. Found from each vertex's neighbours, towards the larger vertex id.
-    pub fn edges(&self, copies: Copies) -> Vec<Simplex> {
+    pub fn edges(&self, copies: Copies) -> Vec<Simplex<D>> {
         let id = move |x: u32| match copies {
             Copies::Unique => self.point_input[self.engine.point_of(x) as usize],
             Copies::Stored => x,
@@ -388,7 +416,7 @@ impl PeriodicDelaunay3 {
                 .into_iter()
                 .filter(move |w| w.0 > v)
                 .map(move |(w, rel)| {
-                    let (vertices, offsets) = canonical(&[id(v), id(w)], &[[0; 3], rel]);
+                    let (vertices, offsets) = canonical(&[id(v), id(w)], &[[0; D], rel]);
                     Simplex { vertices, offsets }
                 })
         });
@@ -400,13 +428,13 @@ impl PeriodicDelaunay3 {
 
     /// The facets, each once (from the cell with the smaller id); `Stored` lists covering
     /// copies by vertex id.
-    pub fn facets(&self, copies: Copies) -> Vec<Simplex> {
+    pub fn facets(&self, copies: Copies) -> Vec<Simplex<D>> {
         let all = self.engine.cell_ids().flat_map(|c| {
             let n = self.engine.cell(c).n;
-            (0..4).filter(move |&i| c < n[i]).map(move |i| (c, i))
+            (0..N).filter(move |&i| c < n[i]).map(move |i| (c, i))
         });
         let face = |(c, i): (u32, usize)| {
-            let idx: Vec<usize> = (0..4).filter(|&k| k != i).collect();
+            let idx: Vec<usize> = (0..N).filter(|&k| k != i).collect();
             self.face(c, &idx, copies)
         };
         if copies == Copies::Unique && !self.is_one_sheeted() {
@@ -417,9 +445,9 @@ impl PeriodicDelaunay3 {
 
     /// The neighbours of input point `i`: (input id, offset of the neighbour relative to
     /// the point), one entry per Delaunay edge at the point, from the point's star.
-    pub fn vertex_neighbors(&self, i: usize) -> Vec<(u32, Offset)> {
+    pub fn vertex_neighbors(&self, i: usize) -> Vec<(u32, Offset<D>)> {
         let v = self.engine.vertex_of_point(self.input_point[i]);
-        let mut out: Vec<(u32, Offset)> = self
+        let mut out: Vec<(u32, Offset<D>)> = self
             .engine
             .neighbours(v)
             .into_iter()
@@ -430,7 +458,7 @@ impl PeriodicDelaunay3 {
     }
 
     /// The cell containing `p` (wrapped into the domain) and the offset of `p` in its frame.
-    pub fn locate(&mut self, p: [f64; 3]) -> Result<(CellView, Offset)> {
+    pub fn locate(&mut self, p: [f64; D]) -> Result<(CellView<D, N>, Offset<D>)> {
         if self.number_of_vertices() == 0 {
             return Err(Error::EmptyInput);
         }
@@ -448,9 +476,9 @@ impl PeriodicDelaunay3 {
 
 /// Canonical form of a simplex given by vertices and offsets: sorted pairs, translated so
 /// that the componentwise minimum offset is zero.
-fn canonical(v: &[u32], o: &[Offset]) -> (Vec<u32>, Vec<Offset>) {
-    let mut pairs: Vec<(u32, Offset)> = v.iter().copied().zip(o.iter().copied()).collect();
-    for c in 0..3 {
+fn canonical<const D: usize>(v: &[u32], o: &[Offset<D>]) -> (Vec<u32>, Vec<Offset<D>>) {
+    let mut pairs: Vec<(u32, Offset<D>)> = v.iter().copied().zip(o.iter().copied()).collect();
+    for c in 0..D {
         let m = pairs.iter().map(|p| p.1[c]).min().unwrap();
         for p in pairs.iter_mut() {
             p.1[c] -= m;

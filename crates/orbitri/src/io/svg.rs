@@ -1,0 +1,288 @@
+//! Pictures of a 2D periodic triangulation: the Delaunay edges, the Voronoi diagram and the
+//! points over `K × K` periodic copies of the domain, the original domain outlined, as SVG.
+
+use std::fmt::Write as _;
+use std::io::Write;
+
+use crate::periodic::PeriodicDelaunay2;
+
+/// What to draw.
+#[derive(Clone, Copy, Debug)]
+pub struct SvgOptions {
+    /// Copies of the domain per lattice direction (the window is `K × K` domains, the
+    /// original one in the middle for odd `K`).
+    pub copies: u32,
+    /// Width of the picture in pixels.
+    pub width: f64,
+    pub delaunay: bool,
+    pub voronoi: bool,
+    pub points: bool,
+}
+
+impl Default for SvgOptions {
+    fn default() -> Self {
+        SvgOptions {
+            copies: 3,
+            width: 800.0,
+            delaunay: true,
+            voronoi: true,
+            points: true,
+        }
+    }
+}
+
+/// A Cartesian segment or point set with its extent in fractional coordinates, to be drawn
+/// at every lattice translation that brings it into the window.
+struct Shape {
+    pts: Vec<[f64; 2]>,
+    fmin: [f64; 2],
+    fmax: [f64; 2],
+}
+
+/// The page: the window in fractional coordinates `[lo, hi)²`, the lattice, and the map
+/// from Cartesian coordinates to pixels (y up).
+struct Page {
+    lo: f64,
+    hi: f64,
+    m: [[f64; 2]; 2],
+    origin: [f64; 2],
+    top: f64,
+    scale: f64,
+}
+
+impl Page {
+    fn px(&self, p: [f64; 2]) -> (f64, f64) {
+        (
+            (p[0] - self.origin[0]) * self.scale,
+            (self.top - p[1]) * self.scale,
+        )
+    }
+
+    fn cart(&self, f: [f64; 2]) -> [f64; 2] {
+        [
+            f[0] * self.m[0][0] + f[1] * self.m[1][0],
+            f[0] * self.m[0][1] + f[1] * self.m[1][1],
+        ]
+    }
+
+    /// Every translation `t` with `[fmin + t, fmax + t]` meeting the window.
+    fn translations(&self, s: &Shape) -> impl Iterator<Item = [f64; 2]> {
+        let range = |c: usize| {
+            let a = (self.lo - s.fmax[c]).ceil() as i64;
+            let b = (self.hi - s.fmin[c]).floor() as i64;
+            a..=b
+        };
+        let (rx, ry) = (range(0), range(1));
+        let m = self.m;
+        rx.flat_map(move |i| {
+            ry.clone().map(move |j| {
+                let (i, j) = (i as f64, j as f64);
+                [i * m[0][0] + j * m[1][0], i * m[0][1] + j * m[1][1]]
+            })
+        })
+    }
+
+    /// SVG path data of the shapes as polylines, at every translation into the window.
+    fn path(&self, shapes: &[Shape]) -> String {
+        let mut d = String::new();
+        for s in shapes {
+            for t in self.translations(s) {
+                for (k, p) in s.pts.iter().enumerate() {
+                    let (x, y) = self.px([p[0] + t[0], p[1] + t[1]]);
+                    let _ = write!(d, "{}{x:.2} {y:.2}", if k == 0 { "M" } else { "L" });
+                }
+            }
+        }
+        d
+    }
+}
+
+fn shape(tri: &PeriodicDelaunay2, pts: Vec<[f64; 2]>) -> Shape {
+    let lattice = tri.space().lattice();
+    let mut fmin = [f64::INFINITY; 2];
+    let mut fmax = [f64::NEG_INFINITY; 2];
+    for p in &pts {
+        let f = lattice.fractional(p);
+        for c in 0..2 {
+            fmin[c] = fmin[c].min(f[c]);
+            fmax[c] = fmax[c].max(f[c]);
+        }
+    }
+    Shape { pts, fmin, fmax }
+}
+
+/// Circumcenter of a triangle (Cartesian).
+pub(crate) fn circumcenter(p: [[f64; 2]; 3]) -> [f64; 2] {
+    let (ax, ay) = (p[1][0] - p[0][0], p[1][1] - p[0][1]);
+    let (bx, by) = (p[2][0] - p[0][0], p[2][1] - p[0][1]);
+    let d = 2.0 * (ax * by - ay * bx);
+    let (la, lb) = (ax * ax + ay * ay, bx * bx + by * by);
+    [
+        p[0][0] + (by * la - ay * lb) / d,
+        p[0][1] + (ax * lb - bx * la) / d,
+    ]
+}
+
+/// The Delaunay edges (one per orbit) as segments.
+fn delaunay_edges(tri: &PeriodicDelaunay2) -> Vec<Shape> {
+    let torus = tri.space();
+    tri.edges(crate::Copies::Unique)
+        .into_iter()
+        .map(|e| {
+            let pts = (0..2)
+                .map(|k| {
+                    let v = tri.vertex_of_input(e.vertices[k] as usize);
+                    torus.position((tri.points()[v as usize], e.offsets[k]))
+                })
+                .collect();
+            shape(tri, pts)
+        })
+        .collect()
+}
+
+/// The Voronoi edges: for each pair of adjacent stored triangles, the segment between their
+/// circumcenters, the neighbour's moved into the triangle's frame.
+fn voronoi_edges(tri: &PeriodicDelaunay2) -> Vec<Shape> {
+    let e = tri.engine();
+    let torus = tri.space();
+    let center = |c: u32| circumcenter(e.lifted_cell(c).map(|l| torus.position(l)));
+    let mut out = Vec::new();
+    for c in e.cell_ids() {
+        let cell = e.cell(c);
+        for i in 0..3 {
+            let d = cell.n[i];
+            if d < c {
+                continue;
+            }
+            let t = e.translation(c, i, d);
+            let shift = torus.position(([0.0; 2], t));
+            let a = center(c);
+            let b = center(d);
+            out.push(shape(tri, vec![a, [b[0] + shift[0], b[1] + shift[1]]]));
+        }
+    }
+    out
+}
+
+/// Writes the picture as SVG.
+pub fn write_svg(
+    w: &mut impl Write,
+    tri: &PeriodicDelaunay2,
+    opts: &SvgOptions,
+) -> std::io::Result<()> {
+    let k = opts.copies.max(1) as f64;
+    let lo = -f64::from((opts.copies.max(1) - 1) / 2);
+    let m = tri.space().lattice().vectors();
+    let mut page = Page {
+        lo,
+        hi: lo + k,
+        m,
+        origin: [0.0; 2],
+        top: 0.0,
+        scale: 1.0,
+    };
+    let corners = [[lo, lo], [lo + k, lo], [lo + k, lo + k], [lo, lo + k]].map(|f| page.cart(f));
+    let (xmin, xmax, ymin, ymax) = corners.iter().fold(
+        (
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        ),
+        |(a, b, c, d), p| (a.min(p[0]), b.max(p[0]), c.min(p[1]), d.max(p[1])),
+    );
+    let pad = 0.02 * (xmax - xmin).max(ymax - ymin);
+    page.origin = [xmin - pad, 0.0];
+    page.top = ymax + pad;
+    page.scale = opts.width / (xmax - xmin + 2.0 * pad);
+    let height = (ymax - ymin + 2.0 * pad) * page.scale;
+    // strokes scale with the density of the picture
+    let n = tri.number_of_vertices().max(1) as f64;
+    let stroke = (opts.width / (k * n.sqrt()) / 25.0).clamp(0.15, 1.5);
+    let polygon = |ps: &[[f64; 2]]| -> String {
+        ps.iter()
+            .map(|p| {
+                let (x, y) = page.px(*p);
+                format!("{x:.2},{y:.2}")
+            })
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    writeln!(
+        w,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{:.0}" height="{height:.0}" viewBox="0 0 {:.2} {height:.2}">"#,
+        opts.width, opts.width
+    )?;
+    writeln!(
+        w,
+        r#"<defs><clipPath id="window"><polygon points="{}"/></clipPath></defs>"#,
+        polygon(&corners)
+    )?;
+    writeln!(w, r#"<rect width="100%" height="100%" fill="white"/>"#)?;
+    writeln!(w, r#"<g clip-path="url(#window)" fill="none">"#)?;
+    if opts.voronoi {
+        writeln!(
+            w,
+            r##"<path id="voronoi" stroke="#c8553d" stroke-width="{stroke:.2}" d="{}"/>"##,
+            page.path(&voronoi_edges(tri))
+        )?;
+    }
+    if opts.delaunay {
+        writeln!(
+            w,
+            r##"<path id="delaunay" stroke="#2a6f97" stroke-width="{:.2}" d="{}"/>"##,
+            stroke * 0.8,
+            page.path(&delaunay_edges(tri))
+        )?;
+    }
+    if opts.points {
+        let r = (stroke * 2.0).max(0.8);
+        let mut pts = String::new();
+        for p in tri.points() {
+            let s = shape(tri, vec![*p]);
+            for t in page.translations(&s) {
+                let (x, y) = page.px([p[0] + t[0], p[1] + t[1]]);
+                let fill = if t == [0.0, 0.0] { "#111" } else { "#777" };
+                let _ = writeln!(
+                    pts,
+                    r#"<circle cx="{x:.2}" cy="{y:.2}" r="{r:.2}" fill="{fill}"/>"#
+                );
+            }
+        }
+        write!(w, "<g id=\"points\">\n{pts}</g>\n")?;
+    }
+    writeln!(w, "</g>")?;
+    // domain copies dashed, the original domain solid
+    let mut copies = String::new();
+    let steps = opts.copies.max(1) as i64;
+    for i in 0..steps {
+        for j in 0..steps {
+            let (fi, fj) = (lo + i as f64, lo + j as f64);
+            let cell = [
+                [fi, fj],
+                [fi + 1.0, fj],
+                [fi + 1.0, fj + 1.0],
+                [fi, fj + 1.0],
+            ];
+            let _ = writeln!(
+                copies,
+                r#"<polygon points="{}"/>"#,
+                polygon(&cell.map(|f| page.cart(f)))
+            );
+        }
+    }
+    writeln!(
+        w,
+        r##"<g id="domains" fill="none" stroke="#555" stroke-width="{:.2}" stroke-dasharray="6 4">
+{copies}</g>"##,
+        stroke
+    )?;
+    let domain = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]].map(|f| page.cart(f));
+    writeln!(
+        w,
+        r##"<polygon id="domain" points="{}" fill="none" stroke="#000" stroke-width="{:.2}"/>"##,
+        polygon(&domain),
+        stroke * 3.0
+    )?;
+    writeln!(w, "</svg>")
+}
