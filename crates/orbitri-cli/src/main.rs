@@ -397,6 +397,43 @@ fn demo(n: usize, seed: u64) -> Result<(), CliError> {
             tri.number_of_cells()
         ),
     );
+    // 2D: the same engine on the unit square, then a honeycomb (6 cocircular points around
+    // every hexagon) in its hexagonal cell
+    let (tri, cost) = build::<2, 3>(FlatTorus2::cuboid([1.0; 2])?, &uniform::<2>(n, seed))?;
+    say(
+        &mut out,
+        format!("uniform random points in the unit square (seed {seed}):"),
+    );
+    say(&mut out, format!("  {}", stats_line(&tri, n, &cost)));
+    tri.is_valid().map_err(|e| CliError::Check(e.to_string()))?;
+    let h = 3f64.sqrt() / 2.0;
+    let hex = FlatTorus2::triclinic([[1.0, 0.0], [0.5, h]])?;
+    let mut honey = Vec::new();
+    for i in 0..20 {
+        for j in 0..20 {
+            for b in [1.0 / 3.0, 2.0 / 3.0] {
+                let f = [(i as f64 + b) / 20.0, (j as f64 + b) / 20.0];
+                honey.push(hex.lattice().cartesian(&f));
+            }
+        }
+    }
+    let (tri, cost) = build::<2, 3>(hex, &honey)?;
+    say(
+        &mut out,
+        "honeycomb, 800 points in a hexagonal cell, 6 cocircular points per hexagon:".to_string(),
+    );
+    say(
+        &mut out,
+        format!("  {}", stats_line(&tri, honey.len(), &cost)),
+    );
+    tri.is_valid().map_err(|e| CliError::Check(e.to_string()))?;
+    say(
+        &mut out,
+        format!(
+            "  {} triangles = 2 per point; valid. Pictures: orbitri draw POINTS --box 1 1 -o t.svg",
+            tri.number_of_cells()
+        ),
+    );
     Ok(())
 }
 

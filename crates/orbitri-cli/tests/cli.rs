@@ -249,3 +249,103 @@ fn demo_runs() {
         "{text}"
     );
 }
+
+#[test]
+fn two_dimensional_boxes_and_lattices() {
+    let dir = tempfile::tempdir().unwrap();
+    let pts = dir.path().join("p2.txt");
+    let o = orbitri(&["generate", "500", "--dim", "2", "-o", pts.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let input = pts.to_str().unwrap();
+    for domain in [
+        vec!["--box", "1", "1"],
+        vec!["--lattice", "1", "0", "0.5", "0.8660254037844386"],
+    ] {
+        let mut args = vec!["triangulate", input];
+        args.extend_from_slice(&domain);
+        args.push("--stats");
+        let o = orbitri(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let text = String::from_utf8(o.stdout.clone()).unwrap();
+        let mut lines = text.lines();
+        // a torus has exactly 2 triangles per point
+        assert_eq!(lines.next().unwrap(), "1 500 1000");
+        let rows: Vec<Vec<i64>> = lines
+            .map(|l| l.split(' ').map(|x| x.parse().unwrap()).collect())
+            .collect();
+        assert_eq!(rows.len(), 1000);
+        // 3 ids and 3 offsets of 2 integers, every id used
+        assert!(rows.iter().all(|r| r.len() == 9));
+        let mut used = vec![false; 500];
+        rows.iter()
+            .for_each(|r| (0..3).for_each(|k| used[r[k] as usize] = true));
+        assert!(used.iter().all(|&u| u));
+        assert!(stderr(&o).contains("cells=1000 sheets=1"), "{}", stderr(&o));
+    }
+    // three numbers per line are not 2D points, and a 2D lattice takes 4 numbers
+    let bad = write(dir.path(), "p3.txt", "0.1 0.2 0.3\n");
+    let o = orbitri(&["triangulate", bad.to_str().unwrap(), "--box", "1", "1"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("p3.txt:1"), "{}", stderr(&o));
+    let o = orbitri(&["triangulate", input, "--lattice", "1", "0", "0", "1", "0"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("4 numbers"), "{}", stderr(&o));
+}
+
+#[test]
+fn draw_writes_svg_and_png() {
+    let dir = tempfile::tempdir().unwrap();
+    let pts = dir.path().join("p2.txt");
+    orbitri(&["generate", "60", "--dim", "2", "-o", pts.to_str().unwrap()]);
+    let svg = dir.path().join("t.svg");
+    let o = orbitri(&[
+        "draw",
+        pts.to_str().unwrap(),
+        "--box",
+        "1",
+        "1",
+        "--copies",
+        "2",
+        "-o",
+        svg.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(&svg).unwrap();
+    assert!(text.starts_with("<svg"));
+    for id in ["voronoi", "delaunay", "points", "domain"] {
+        assert!(text.contains(&format!("id=\"{id}\"")), "{id}");
+    }
+    // 60 points in 2×2 copies of the domain (plus copies on the window's edge)
+    assert!(text.matches("<circle").count() >= 240);
+    let png = dir.path().join("t.png");
+    let o = orbitri(&[
+        "draw",
+        pts.to_str().unwrap(),
+        "--lattice",
+        "1",
+        "0",
+        "0.3",
+        "0.9",
+        "--width",
+        "300",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let bytes = std::fs::read(&png).unwrap();
+    assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
+    // width 300 in the IHDR chunk
+    assert_eq!(u32::from_be_bytes(bytes[16..20].try_into().unwrap()), 300);
+    let o = orbitri(&[
+        "draw",
+        pts.to_str().unwrap(),
+        "--box",
+        "1",
+        "1",
+        "1",
+        "-o",
+        "x.svg",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("2D"), "{}", stderr(&o));
+}

@@ -298,6 +298,16 @@ where
         self.engine.sheets()
     }
 
+    /// Moves a triangulation still in a covering space to the 1-sheeted torus if its
+    /// projection there is a simplicial complex (no cycle of length ≤ 2), even though the
+    /// criterion does not yet guarantee it for more points; later insertions check that the
+    /// quotient stays simplicial and go back to the covering when it would not. `build` does
+    /// this at its end; after `insert` calls it is the caller's choice (CGAL's
+    /// `convert_to_1_sheeted_covering`). Returns whether the triangulation is 1-sheeted.
+    pub fn try_one_sheet(&mut self) -> bool {
+        self.engine.try_one_sheet()
+    }
+
     /// True when the stored triangulation is the 1-sheeted quotient.
     pub fn is_one_sheeted(&self) -> bool {
         self.engine.is_one_sheeted()

@@ -559,6 +559,63 @@ mod tests {
     }
 
     #[test]
+    fn halving_ladders_are_nested_and_safe() {
+        let h = 3f64.sqrt() / 2.0;
+        for l in [
+            Lattice::cuboid([1.0, 1.0]).unwrap(),
+            Lattice::cuboid([1.0, 3.0]).unwrap(),
+            Lattice::new([[1.0, 0.0], [0.5, h]]).unwrap(),
+            Lattice::new([[1.0, 0.0], [-0.35, 0.8]]).unwrap(),
+        ] {
+            let ladder = l.ladder(Ladder::Halving);
+            assert!(ladder.last().unwrap().sub.is_identity());
+            // level 0 triangulates a single point
+            assert!(ladder[0].systole > l.one_point_need());
+            for w in ladder.windows(2) {
+                // each level is a sublattice of the next, of index a power of two
+                for row in w[0].sub.rows() {
+                    assert_eq!(w[1].sub.reduce(row), [0, 0]);
+                }
+                let ratio = w[0].sub.index() / w[1].sub.index();
+                assert!(ratio.is_power_of_two() && ratio >= 2);
+                // and a strictly longer shortest vector, else the level would be useless
+                assert!(w[0].systole > w[1].systole);
+                // the systole is that of the sublattice, checked by brute force
+                let m = l.vectors();
+                let rows = w[0].sub.rows();
+                let mut best = f64::INFINITY;
+                for x in -6i32..=6 {
+                    for y in -6i32..=6 {
+                        if (x, y) == (0, 0) {
+                            continue;
+                        }
+                        let t = [
+                            x * rows[0][0] + y * rows[1][0],
+                            x * rows[0][1] + y * rows[1][1],
+                        ];
+                        let v = [
+                            t[0] as f64 * m[0][0] + t[1] as f64 * m[1][0],
+                            t[0] as f64 * m[0][1] + t[1] as f64 * m[1][1],
+                        ];
+                        best = best.min(v[0].hypot(v[1]));
+                    }
+                }
+                assert!(
+                    (best - w[0].systole).abs() < 1e-12,
+                    "{best} {}",
+                    w[0].systole
+                );
+            }
+        }
+        // the grid ladder is the thesis's covering
+        let cube = Lattice::cuboid([1.0; 3]).unwrap().ladder(Ladder::Grid);
+        assert_eq!(
+            cube.iter().map(|l| l.sub.index()).collect::<Vec<_>>(),
+            [27, 1]
+        );
+    }
+
+    #[test]
     fn dummy_grid_size() {
         assert_eq!(Lattice::cuboid([1.0; 3]).unwrap().dummy_grid().len(), 64);
     }
