@@ -5,6 +5,8 @@
 # and prints the summary table (bench/summarize.py) that BENCHMARKS.md reproduces.
 #
 # usage: bench/run.sh [REPS] [N ...]        default: 5 reps, N = 100 10000 100000 1000000
+#        CUBE=0 bench/run.sh ...            skip the uniform unit cube (3D)
+#        SQUARE=0 bench/run.sh ...          skip the uniform unit square (2D)
 #        CLUSTERED=0 bench/run.sh ...       skip the clustered set
 #        CLUSTER_REPS=3 (default)            repetitions of the clustered set: CGAL needs its
 #                                            27-sheeted cover there and takes ~75 s per run
@@ -34,14 +36,21 @@ raw=$out/raw.txt
 stamp="commit=$(git -C "$root" rev-parse --short HEAD) date=$(date -u +%F)"
 load() { cut -d' ' -f1 /proc/loadavg; }
 
-for n in $ns; do
-    pts=$out/cube_$n.txt
-    [ -f "$pts" ] || "$orb" generate "$n" --seed 1 -o "$pts"
-    for rep in $(seq "$reps"); do
-        line=$("$orb" triangulate "$pts" --box 1 1 1 --stats -o /dev/null 2>&1 >/dev/null)
-        echo "tool=orbitri input=cube N=$n rep=$rep $line load1=$(load) $stamp" | tee -a "$raw"
-        for c in p3dt3 p3dt3f dt3; do
-            echo "tool=cgal input=cube rep=$rep $("$cgal" "$c" "$n" 1) load1=$(load) $stamp" | tee -a "$raw"
+# input name, dimension, box, CGAL commands
+cases=()
+[ "${CUBE:-1}" = 1 ] && cases+=("cube 3 1,1,1 p3dt3,p3dt3f,dt3")
+[ "${SQUARE:-1}" = 1 ] && cases+=("square 2 1,1 p2dt2,p2dt2f,dt2")
+for case in "${cases[@]}"; do
+    read -r input dim box cmds <<<"$case"
+    for n in $ns; do
+        pts=$out/${input}_$n.txt
+        [ -f "$pts" ] || "$orb" generate "$n" --seed 1 --dim "$dim" -o "$pts"
+        for rep in $(seq "$reps"); do
+            line=$("$orb" triangulate "$pts" --box ${box//,/ } --stats -o /dev/null 2>&1 >/dev/null)
+            echo "tool=orbitri input=$input N=$n rep=$rep $line load1=$(load) $stamp" | tee -a "$raw"
+            for c in ${cmds//,/ }; do
+                echo "tool=cgal input=$input rep=$rep $("$cgal" "$c" "$n" 1) load1=$(load) $stamp" | tee -a "$raw"
+            done
         done
     done
 done

@@ -71,7 +71,9 @@ impl OrbitSpace<3> for FlatTorus<2> {
     }
 
     fn spatial_key(&self, p: &[f64; 2]) -> u64 {
-        crate::sort::hilbert(self.grid_cell(p, 31), 31)
+        // 2^16 cells per axis: far finer than any input's spacing needs for a sort, and half
+        // the work of 31 bits (the key took 8% of a 10⁶-point build)
+        crate::sort::hilbert(self.grid_cell(p, 16), 16)
     }
 }
 
