@@ -15,7 +15,7 @@ pub enum Ladder {
     /// Sublattices of index `2^k`, each of index 2 in the next (Bogdanov–Teillaud–Vegter,
     /// EuroCG 2012), descended one step whenever the next step's criterion holds: 16 (one
     /// point only), 8, 4, 2 and 1 sheets for a square. Each step keeps the sublattice of index
-    /// 2 with the longest shortest vector.
+    /// 2 with the longest shortest vector. 2D only; other dimensions get [`Ladder::Grid`].
     #[default]
     Halving,
 }
@@ -269,7 +269,10 @@ impl<const D: usize> Lattice<D> {
                 identity.clone(),
             ]
         };
-        if kind == Ladder::Grid {
+        // In 3D an index-2^k covering safe for one point of a cube has at least 32 sheets
+        // (Hermite's constant bounds its systole: δ³ ≤ √2·index, and δ > 2√3 is needed), more
+        // than the grid's 27: halving is for 2D.
+        if kind == Ladder::Grid || D != 2 {
             return grid();
         }
         let need = self.one_point_need();
@@ -607,12 +610,14 @@ mod tests {
                 );
             }
         }
-        // the grid ladder is the thesis's covering
-        let cube = Lattice::cuboid([1.0; 3]).unwrap().ladder(Ladder::Grid);
-        assert_eq!(
-            cube.iter().map(|l| l.sub.index()).collect::<Vec<_>>(),
-            [27, 1]
-        );
+        // the grid ladder is the thesis's covering, also what 3D gets for halving
+        for kind in [Ladder::Grid, Ladder::Halving] {
+            let cube = Lattice::cuboid([1.0; 3]).unwrap().ladder(kind);
+            assert_eq!(
+                cube.iter().map(|l| l.sub.index()).collect::<Vec<_>>(),
+                [27, 1]
+            );
+        }
     }
 
     #[test]
