@@ -25,6 +25,7 @@ pub mod predicates;
 pub mod sort;
 pub mod space;
 pub mod tds;
+pub mod voronoi;
 
 pub use delaunay::{Engine, Inserted, Invalid};
 pub use error::{Error, Result};
@@ -32,3 +33,4 @@ pub use periodic::{
     BuildOptions, CellView, Copies, PeriodicDelaunay, PeriodicDelaunay2, PeriodicDelaunay3, Simplex,
 };
 pub use space::{FlatTorus, FlatTorus2, FlatTorus3, Ladder, Lattice, OrbitSpace};
+pub use voronoi::{Neighbor, VoronoiCell, VoronoiFace};

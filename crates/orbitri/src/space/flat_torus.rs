@@ -343,6 +343,14 @@ macro_rules! flat_torus_plugin {
             Self::sub(a, b)
         }
 
+        fn cospherical(
+            &self,
+            s: &[(Self::Point, Self::Offset); $n],
+            q: (Self::Point, Self::Offset),
+        ) -> bool {
+            self.in_sphere_raw(s, q) == crate::predicates::Sign::Zero
+        }
+
         fn coincide(&self, a: (Self::Point, Self::Offset), b: (Self::Point, Self::Offset)) -> bool {
             self.coincide_lifted(a, b)
         }

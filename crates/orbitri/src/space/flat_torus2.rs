@@ -30,6 +30,13 @@ impl FlatTorus<2> {
         let m = |a: usize, b: usize| &d[a][0] * &d[b][1] - &d[a][1] * &d[b][0];
         exact::sign(&(&len[0] * m(1, 2) - &len[1] * m(0, 2) + &len[2] * m(0, 1)))
     }
+
+    /// The in-circle sign without perturbation (`Zero` when cocircular), exact.
+    #[inline(always)]
+    fn in_sphere_raw(&self, s: &[L2; 3], q: L2) -> Sign {
+        let (d, b) = self.rows([&s[0], &s[1], &s[2]], &q);
+        filter::in_circle(&d, b).unwrap_or_else(|| self.in_circle_exact(s, q))
+    }
 }
 
 impl OrbitSpace<3> for FlatTorus<2> {
@@ -46,8 +53,7 @@ impl OrbitSpace<3> for FlatTorus<2> {
 
     #[inline(always)]
     fn in_sphere(&self, s: &[L2; 3], q: L2) -> Sign {
-        let (d, b) = self.rows([&s[0], &s[1], &s[2]], &q);
-        match filter::in_circle(&d, b).unwrap_or_else(|| self.in_circle_exact(s, q)) {
+        match self.in_sphere_raw(s, q) {
             Sign::Zero => self.perturbed(s, q, |t| self.orient(t)),
             sign => sign,
         }

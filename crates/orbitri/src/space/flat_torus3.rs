@@ -36,6 +36,13 @@ impl FlatTorus<3> {
             + &len[3] * exact::det3(&d[0], &d[1], &d[2]);
         exact::sign(&det).flip()
     }
+
+    /// The in-sphere sign without perturbation (`Zero` when cospherical), exact.
+    #[inline(always)]
+    fn in_sphere_raw(&self, s: &[L3; 4], q: L3) -> Sign {
+        let (d, b) = self.rows([&s[0], &s[1], &s[2], &s[3]], &q);
+        filter::in_sphere3(&d, b).unwrap_or_else(|| self.in_sphere_exact(s, q))
+    }
 }
 
 impl OrbitSpace<4> for FlatTorus<3> {
@@ -52,8 +59,7 @@ impl OrbitSpace<4> for FlatTorus<3> {
 
     #[inline(always)]
     fn in_sphere(&self, s: &[L3; 4], q: L3) -> Sign {
-        let (d, b) = self.rows([&s[0], &s[1], &s[2], &s[3]], &q);
-        match filter::in_sphere3(&d, b).unwrap_or_else(|| self.in_sphere_exact(s, q)) {
+        match self.in_sphere_raw(s, q) {
             Sign::Zero => self.perturbed(s, q, |t| self.orient(t)),
             sign => sign,
         }

@@ -41,6 +41,13 @@ pub trait OrbitSpace<const N: usize>: Sync + Send {
         s: &[Lifted<Self::Point, Self::Offset>; N],
         q: Lifted<Self::Point, Self::Offset>,
     ) -> Sign;
+    /// Exact test whether `q` lies on the circumsphere of `s` (no perturbation): the
+    /// Voronoi vertices of such cells coincide.
+    fn cospherical(
+        &self,
+        s: &[Lifted<Self::Point, Self::Offset>; N],
+        q: Lifted<Self::Point, Self::Offset>,
+    ) -> bool;
     /// Exact test whether two lifted points coincide.
     fn coincide(
         &self,
