@@ -12,6 +12,8 @@ use orbitri::{
 };
 
 type Poly3 = Vec<Vec<[f64; 3]>>;
+/// A bisector half-space `n·x ≤ d` of a neighbour image: (|n|², id, shift, n, d).
+type Bisector = (f64, u32, [i8; 3], [f64; 3], f64);
 
 fn sub3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
@@ -121,7 +123,7 @@ fn clipped3(m: [[f64; 3]; 3], pts: &[[f64; 3]], i: usize) -> (f64, BTreeSet<(u32
             poly.push(face);
         }
     }
-    let mut planes: Vec<(f64, u32, [i8; 3], [f64; 3], f64)> = Vec::new();
+    let mut planes: Vec<Bisector> = Vec::new();
     for (j, q) in pts.iter().enumerate() {
         for x in -2i8..=2 {
             for y in -2i8..=2 {
