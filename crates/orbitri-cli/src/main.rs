@@ -40,6 +40,30 @@ enum Command {
         #[command(flatten)]
         out: Output,
     },
+    /// Compute the periodic Voronoi cell of every point of INPUT: one row per input point
+    /// (`id,volume,neighbours,surface_area,centroid_…,duplicate_of`, input order) as CSV or
+    /// `.npy`, or the whole cells as JSON or VTK (`.vtu`, for ParaView).
+    Voronoi {
+        /// Input file (text or .npy)
+        input: PathBuf,
+        #[command(flatten)]
+        domain: Domain,
+        /// Output file (default: standard output); its extension picks the format
+        #[arg(short = 'o', long)]
+        output: Option<PathBuf>,
+        /// Output format (default: from the output's extension, else csv)
+        #[arg(long, value_enum)]
+        format: Option<VoronoiFormat>,
+        /// Also write the neighbour pairs `i,j,shift…,area` (each pair once) as CSV here
+        #[arg(long)]
+        neighbours: Option<PathBuf>,
+        /// Also write the Delaunay edges `i,j,shift…,length` as CSV here
+        #[arg(long)]
+        edges: Option<PathBuf>,
+        /// Print one line of key=value statistics to standard error
+        #[arg(long)]
+        stats: bool,
+    },
     /// Draw the periodic Delaunay triangulation and Voronoi diagram of 2D points over copies
     /// of the domain, to SVG (or PNG for a `.png` output name).
     Draw {
@@ -119,6 +143,20 @@ enum Format {
     Cells,
     /// JSON with lattice, wrapped points, first occurrences, cells and offsets
     Json,
+    /// VTK UnstructuredGrid (ParaView): one copy of each cell, drawn whole
+    Vtu,
+}
+
+#[derive(Clone, Copy, PartialEq, ValueEnum)]
+enum VoronoiFormat {
+    /// One row per input point: id, volume, neighbours, surface area, centroid, duplicate_of
+    Csv,
+    /// The same columns as a float64 N×K array
+    Npy,
+    /// Every cell: vertices, faces (vertex cycles, neighbour, shift, area), volume, centroid
+    Json,
+    /// VTK UnstructuredGrid of the cells (polyhedra in 3D, polygons in 2D), drawn whole
+    Vtu,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -274,11 +312,84 @@ where
     let res = match out.format {
         Format::Cells => orbitri::io::write_cells(&mut w, &tri),
         Format::Json => orbitri::io::write_json(&mut w, &tri),
+        Format::Vtu => orbitri::io::write_delaunay_vtu(&mut w, &tri),
     };
     res.and_then(|_| w.flush())
         .map_err(|source| CliError::Write { path, source })?;
     if out.stats {
         eprintln!("{}", stats_line(&tri, pts.len(), &cost));
+    }
+    Ok(())
+}
+
+/// Options of `orbitri voronoi`.
+struct VoronoiArgs {
+    output: Option<PathBuf>,
+    format: Option<VoronoiFormat>,
+    neighbours: Option<PathBuf>,
+    edges: Option<PathBuf>,
+    stats: bool,
+}
+
+fn voronoi(input: PathBuf, domain: Domain, args: VoronoiArgs) -> Result<(), CliError> {
+    match space(&domain)? {
+        Space::Two(s) => voronoi_in::<2, 3>(s, &input, args),
+        Space::Three(s) => voronoi_in::<3, 4>(s, &input, args),
+    }
+}
+
+/// Writes a file (or standard output) with `f`, naming the path in errors.
+fn write_with(
+    path: &Option<PathBuf>,
+    f: impl FnOnce(&mut Box<dyn Write>) -> std::io::Result<()>,
+) -> Result<(), CliError> {
+    let name = path.clone().unwrap_or_else(|| PathBuf::from("<stdout>"));
+    let mut w = writer(path)?;
+    f(&mut w)
+        .and_then(|_| w.flush())
+        .map_err(|source| CliError::Write { path: name, source })
+}
+
+fn voronoi_in<const D: usize, const N: usize>(
+    space: FlatTorus<D>,
+    input: &Path,
+    args: VoronoiArgs,
+) -> Result<(), CliError>
+where
+    FlatTorus<D>: Torus<D, N>,
+{
+    let pts: Vec<[f64; D]> = orbitri::io::read_points(input)?;
+    let (tri, cost) = build(space, &pts)?;
+    let start = Instant::now();
+    let cells = tri.voronoi_cells();
+    let seconds = start.elapsed().as_secs_f64();
+    let by_extension = args.output.as_ref().and_then(|p| {
+        let ext = p.extension()?.to_str()?.to_ascii_lowercase();
+        VoronoiFormat::from_str(&ext, true).ok()
+    });
+    let format = args.format.or(by_extension).unwrap_or(VoronoiFormat::Csv);
+    write_with(&args.output, |w| match format {
+        VoronoiFormat::Csv => orbitri::io::point_table(&tri, &cells).write_csv(w),
+        VoronoiFormat::Npy => w.write_all(&orbitri::io::point_table(&tri, &cells).npy()),
+        VoronoiFormat::Json => orbitri::io::write_voronoi_json(w, &tri, &cells),
+        VoronoiFormat::Vtu => orbitri::io::write_voronoi_vtu(w, &cells),
+    })?;
+    if args.neighbours.is_some() {
+        let pairs = orbitri::voronoi::neighbor_pairs(&cells);
+        write_with(&args.neighbours, |w| {
+            orbitri::io::write_neighbors_csv(w, &pairs)
+        })?;
+    }
+    if args.edges.is_some() {
+        write_with(&args.edges, |w| orbitri::io::write_edges_csv(w, &tri))?;
+    }
+    if args.stats {
+        let total: f64 = cells.iter().map(|c| c.volume).sum();
+        eprintln!(
+            "{} voronoi_seconds={seconds:.6} volume_sum={total:?} domain_volume={:?}",
+            stats_line(&tri, pts.len(), &cost),
+            tri.space().lattice().volume()
+        );
     }
     Ok(())
 }
@@ -460,6 +571,25 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Triangulate { input, domain, out } => triangulate(input, domain, out),
         Command::Demo { points, seed } => demo(points, seed),
+        Command::Voronoi {
+            input,
+            domain,
+            output,
+            format,
+            neighbours,
+            edges,
+            stats,
+        } => voronoi(
+            input,
+            domain,
+            VoronoiArgs {
+                output,
+                format,
+                neighbours,
+                edges,
+                stats,
+            },
+        ),
         Command::Draw {
             input,
             domain,

@@ -349,3 +349,125 @@ fn draw_writes_svg_and_png() {
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("2D"), "{}", stderr(&o));
 }
+
+#[test]
+fn voronoi_tables_cells_and_vtk() {
+    let dir = tempfile::tempdir().unwrap();
+    // 300 points, then one duplicate of point 7 (a period away)
+    let mut text = random_text(300);
+    let p7: Vec<f64> = text
+        .lines()
+        .nth(8)
+        .unwrap()
+        .split(|c: char| c == ',' || c.is_whitespace())
+        .filter(|s| !s.is_empty())
+        .map(|s| s.parse().unwrap())
+        .collect();
+    text.push_str(&format!("{} {} {}\n", p7[0] + 1.0, p7[1], p7[2]));
+    let input = write(dir.path(), "pts.txt", &text);
+    let csv = dir.path().join("v.csv");
+    let nb = dir.path().join("nb.csv");
+    let edges = dir.path().join("e.csv");
+    let o = orbitri(&[
+        "voronoi",
+        input.to_str().unwrap(),
+        "--box",
+        "1",
+        "1",
+        "1",
+        "-o",
+        csv.to_str().unwrap(),
+        "--neighbours",
+        nb.to_str().unwrap(),
+        "--edges",
+        edges.to_str().unwrap(),
+        "--stats",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let table = std::fs::read_to_string(&csv).unwrap();
+    let mut lines = table.lines();
+    assert_eq!(
+        lines.next().unwrap(),
+        "id,volume,neighbours,surface_area,centroid_x,centroid_y,centroid_z,duplicate_of"
+    );
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    // one row per input point, in input order; the duplicate says so and shares the cell
+    assert_eq!(rows.len(), 301);
+    assert!(rows.iter().enumerate().all(|(i, r)| r[0] == i.to_string()));
+    assert_eq!(rows[300][7], "7");
+    assert_eq!(rows[300][1..7], rows[7][1..7]);
+    let total: f64 = rows[..300]
+        .iter()
+        .map(|r| r[1].parse::<f64>().unwrap())
+        .sum();
+    assert!((total - 1.0).abs() < 1e-12);
+    // each pair once: twice the pairs = the faces counted over the distinct points
+    let faces: usize = rows[..300]
+        .iter()
+        .map(|r| r[2].parse::<usize>().unwrap())
+        .sum();
+    let pairs = std::fs::read_to_string(&nb).unwrap().lines().count() - 1;
+    assert_eq!(2 * pairs, faces);
+    // Euler: E = V + C in 3D; the stats name the cells
+    let edge_rows = std::fs::read_to_string(&edges).unwrap().lines().count() - 1;
+    let err = stderr(&o);
+    let cells: usize = err
+        .split_whitespace()
+        .find_map(|kv| kv.strip_prefix("cells="))
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert_eq!(edge_rows, 300 + cells);
+    assert!(err.contains("volume_sum="), "{err}");
+    // JSON cells, VTK cells and the triangulation as VTK, 2D too
+    for (name, format) in [("v.json", None), ("v.vtu", None), ("v.dat", Some("vtu"))] {
+        let out = dir.path().join(name);
+        let mut args = vec![
+            "voronoi",
+            input.to_str().unwrap(),
+            "--box",
+            "1",
+            "1",
+            "1",
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        if let Some(f) = format {
+            args.extend_from_slice(&["--format", f]);
+        }
+        let o = orbitri(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let text = std::fs::read_to_string(&out).unwrap();
+        if name.ends_with("json") {
+            assert!(text.starts_with("{\"dimension\":3"));
+            assert_eq!(text.matches("\"neighbor\"").count(), faces);
+        } else {
+            assert!(text.contains("<VTKFile type=\"UnstructuredGrid\""));
+            assert!(text.contains("NumberOfCells=\"300\""));
+            assert!(text.contains("Name=\"faceoffsets\""));
+        }
+    }
+    let vtu = dir.path().join("t.vtu");
+    let o = triangulate_cube(&input, &["--format", "vtu", "-o", vtu.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(&vtu).unwrap();
+    assert!(text.contains(&format!("NumberOfCells=\"{cells}\"")));
+    let pts2 = dir.path().join("p2.txt");
+    orbitri(&["generate", "50", "--dim", "2", "-o", pts2.to_str().unwrap()]);
+    let npy = dir.path().join("v.npy");
+    let o = orbitri(&[
+        "voronoi",
+        pts2.to_str().unwrap(),
+        "--box",
+        "1",
+        "1",
+        "-o",
+        npy.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let bytes = std::fs::read(&npy).unwrap();
+    assert_eq!(&bytes[..6], b"\x93NUMPY");
+    let header = String::from_utf8_lossy(&bytes[10..80]).into_owned();
+    // id, volume, neighbours, surface, centroid x y, duplicate_of
+    assert!(header.contains("'shape': (50, 7)"), "{header}");
+}

@@ -30,7 +30,8 @@ pub mod voronoi;
 pub use delaunay::{Engine, Inserted, Invalid};
 pub use error::{Error, Result};
 pub use periodic::{
-    BuildOptions, CellView, Copies, PeriodicDelaunay, PeriodicDelaunay2, PeriodicDelaunay3, Simplex,
+    BuildOptions, CellView, Copies, DelaunayEdge, PeriodicDelaunay, PeriodicDelaunay2,
+    PeriodicDelaunay3, Simplex,
 };
 pub use space::{FlatTorus, FlatTorus2, FlatTorus3, Ladder, Lattice, OrbitSpace};
 pub use voronoi::{Neighbor, VoronoiCell, VoronoiFace};

@@ -50,6 +50,15 @@ pub struct Simplex<const D: usize = 3> {
     pub offsets: Vec<Offset<D>>,
 }
 
+/// A Delaunay edge of the torus: `j`'s image `points[j] + shift·M` is joined to point `i`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DelaunayEdge<const D: usize> {
+    pub i: u32,
+    pub j: u32,
+    pub shift: Offset<D>,
+    pub length: f64,
+}
+
 /// Options of the bulk construction.
 #[derive(Clone, Copy, Debug)]
 pub struct BuildOptions {
@@ -434,6 +443,26 @@ where
             return self.unique_in_covering(all);
         }
         all.collect()
+    }
+
+    /// The Delaunay edges of the torus, each once, with input ids, shift and length.
+    pub fn delaunay_edges(&self) -> Vec<DelaunayEdge<D>> {
+        self.edges(Copies::Unique)
+            .into_iter()
+            .map(|s| {
+                let at = |k: usize| {
+                    let p = self.points()[self.vertex_of_input(s.vertices[k] as usize) as usize];
+                    self.space().position((p, s.offsets[k]))
+                };
+                let (a, b) = (at(0), at(1));
+                DelaunayEdge {
+                    i: s.vertices[0],
+                    j: s.vertices[1],
+                    shift: std::array::from_fn(|c| s.offsets[1][c] - s.offsets[0][c]),
+                    length: (0..D).map(|c| (b[c] - a[c]).powi(2)).sum::<f64>().sqrt(),
+                }
+            })
+            .collect()
     }
 
     /// The facets, each once (from the cell with the smaller id); `Stored` lists covering

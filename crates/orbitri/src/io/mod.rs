@@ -1,12 +1,18 @@
-//! Readers (points from text or `.npy`) and writers (the `cells` format, JSON and SVG).
+//! Readers (points from text or `.npy`) and writers (the `cells` format, JSON, SVG, the
+//! Voronoi tables, and VTK).
 
 mod npy;
 mod svg;
+mod tessellation;
 mod text;
 mod write;
 
-pub use npy::{encode_npy, read_npy};
+pub use npy::{encode_npy, encode_npy_matrix, read_npy};
 pub use svg::{write_svg, SvgOptions};
+pub use tessellation::{
+    point_table, write_delaunay_vtu, write_edges_csv, write_neighbors_csv, write_voronoi_json,
+    write_voronoi_vtu, PointTable,
+};
 pub use text::{parse_text, read_text};
 pub use write::{write_cells, write_json};
 

@@ -110,9 +110,14 @@ fn parse_npy<const D: usize>(bytes: &[u8], path: &Path) -> Result<Vec<[f64; D]>>
 
 /// Encodes an `(N, D)` float64 array as `.npy` (used by tests and tools).
 pub fn encode_npy<const D: usize>(rows: &[[f64; D]]) -> Vec<u8> {
+    encode_npy_matrix(rows.as_flattened(), D)
+}
+
+/// A float64 `.npy` file of shape `(data.len() / cols, cols)`, row-major.
+pub fn encode_npy_matrix(data: &[f64], cols: usize) -> Vec<u8> {
     let mut header = format!(
-        "{{'descr': '<f8', 'fortran_order': False, 'shape': ({}, {D}), }}",
-        rows.len()
+        "{{'descr': '<f8', 'fortran_order': False, 'shape': ({}, {cols}), }}",
+        data.len() / cols
     );
     while (10 + header.len() + 1) % 64 != 0 {
         header.push(' ');
@@ -121,10 +126,8 @@ pub fn encode_npy<const D: usize>(rows: &[[f64; D]]) -> Vec<u8> {
     let mut out = b"\x93NUMPY\x01\x00".to_vec();
     out.extend_from_slice(&(header.len() as u16).to_le_bytes());
     out.extend_from_slice(header.as_bytes());
-    for r in rows {
-        for v in r {
-            out.extend_from_slice(&v.to_le_bytes());
-        }
+    for v in data {
+        out.extend_from_slice(&v.to_le_bytes());
     }
     out
 }
