@@ -109,21 +109,39 @@ fn root(parent: &mut [usize], mut x: usize) -> usize {
     x
 }
 
+/// What every Voronoi cell reads from the triangulation, computed once: each stored cell's
+/// circumcenter (Cartesian, in the cell's own frame), the class of each cell under "adjacent
+/// and cospherical" (one Voronoi vertex per class), and the cells around each vertex.
+struct Duals<const D: usize> {
+    /// Indexed by stored cell id.
+    center: Vec<[f64; D]>,
+    class: Vec<u32>,
+    /// The incident (cell, slot) pairs of vertex `v`: `incident[start[v]..start[v + 1]]`.
+    start: Vec<u32>,
+    incident: Vec<(u32, u8)>,
+}
+
 impl<const D: usize, const N: usize> PeriodicDelaunay<D, N>
 where
     FlatTorus<D>: Torus<D, N>,
 {
     /// The Voronoi cell of input point `i` (a duplicate gets its first occurrence's cell).
     pub fn voronoi_cell(&self, i: usize) -> VoronoiCell<D> {
-        self.cell_of_point(self.vertex_of_input(i))
+        self.cell_of_point(&self.duals(), self.vertex_of_input(i))
     }
 
     /// The Voronoi cells of the distinct points, in the order of their first occurrence
     /// (computed in parallel).
     pub fn voronoi_cells(&self) -> Vec<VoronoiCell<D>> {
-        let mut points: Vec<u32> = (0..self.number_of_vertices() as u32).collect();
-        points.sort_unstable_by_key(|&p| self.input_of_vertex(p));
-        points.par_iter().map(|&p| self.cell_of_point(p)).collect()
+        let duals = self.duals();
+        // in point order, which is the spatially sorted insertion order: neighbouring points
+        // share cells in cache; then in input order
+        let mut cells: Vec<VoronoiCell<D>> = (0..self.number_of_vertices() as u32)
+            .into_par_iter()
+            .map(|p| self.cell_of_point(&duals, p))
+            .collect();
+        cells.sort_unstable_by_key(|c| c.point);
+        cells
     }
 
     /// The Voronoi neighbour pairs with their shared face areas, each unordered pair of
@@ -132,86 +150,138 @@ where
         neighbor_pairs(&self.voronoi_cells())
     }
 
-    /// The cell of point index `p`, from the star of one of its vertices.
-    fn cell_of_point(&self, p: u32) -> VoronoiCell<D> {
+    fn duals(&self) -> Duals<D> {
+        let e = self.engine();
+        let torus = self.space();
+        let ids: Vec<u32> = e.cell_ids().collect();
+        let slots = ids.iter().max().map_or(0, |&m| m as usize + 1);
+        let computed: Vec<[f64; D]> = ids
+            .par_iter()
+            .map(|&c| {
+                let base = torus.position(e.lifted(c, 0));
+                let mut a = [[0.0; D]; D];
+                let mut b = [0.0; D];
+                for i in 1..N {
+                    let q = torus.position(e.lifted(c, i));
+                    let d: [f64; D] = std::array::from_fn(|x| q[x] - base[x]);
+                    a[i - 1] = d;
+                    b[i - 1] = 0.5 * dot(&d, &d);
+                }
+                let x = solve(a, b);
+                std::array::from_fn(|k| base[k] + x[k])
+            })
+            .collect();
+        let mut center = vec![[0.0; D]; slots];
+        for (k, &c) in ids.iter().enumerate() {
+            center[c as usize] = computed[k];
+        }
+        // adjacent cells with one circumsphere: decided exactly, each facet once
+        let merges: Vec<(u32, u32)> = ids
+            .par_iter()
+            .flat_map_iter(|&c| {
+                let cell = e.cell(c);
+                let lifted = e.lifted_cell(c);
+                (0..N).filter_map(move |x| {
+                    let d = cell.n[x];
+                    if d < c {
+                        return None;
+                    }
+                    let dc = e.cell(d);
+                    let y = (0..N)
+                        .find(|&y| dc.n[y] == c)
+                        .expect("symmetric neighbours");
+                    let shift = e.translation(c, x, d);
+                    let opposite = (
+                        self.points()[e.point_of(dc.v[y]) as usize],
+                        torus.compose(dc.off[y], shift),
+                    );
+                    torus.cospherical(&lifted, opposite).then_some((c, d))
+                })
+            })
+            .collect();
+        let mut parent: Vec<usize> = (0..slots).collect();
+        for (c, d) in merges {
+            let (a, b) = (root(&mut parent, c as usize), root(&mut parent, d as usize));
+            parent[a.max(b)] = a.min(b);
+        }
+        let class = (0..slots).map(|c| root(&mut parent, c) as u32).collect();
+        // incidence lists by counting sort
+        let vertices = e.number_of_vertices();
+        let mut start = vec![0u32; vertices + 1];
+        for &c in &ids {
+            for &v in &e.cell(c).v {
+                start[v as usize + 1] += 1;
+            }
+        }
+        for v in 0..vertices {
+            start[v + 1] += start[v];
+        }
+        let mut fill = start.clone();
+        let mut incident = vec![(0u32, 0u8); start[vertices] as usize];
+        for &c in &ids {
+            for (k, &v) in e.cell(c).v.iter().enumerate() {
+                incident[fill[v as usize] as usize] = (c, k as u8);
+                fill[v as usize] += 1;
+            }
+        }
+        Duals {
+            center,
+            class,
+            start,
+            incident,
+        }
+    }
+
+    /// The cell of point index `p`, from the cells around one of its vertices.
+    fn cell_of_point(&self, duals: &Duals<D>, p: u32) -> VoronoiCell<D> {
         let e = self.engine();
         let torus = self.space();
         let v = e.vertex_of_point(p);
-        let star = e.star(v);
+        let star =
+            &duals.incident[duals.start[v as usize] as usize..duals.start[v as usize + 1] as usize];
         let position = self.points()[p as usize];
-        // Voronoi vertices: circumcenters relative to the point, in each star cell's frame
-        let centers: Vec<[f64; D]> = star
+        // one Voronoi vertex per class, relative to the point in the frame of its cells
+        let mut class_ids: Vec<u32> = Vec::with_capacity(star.len());
+        let mut vertices: Vec<[f64; D]> = Vec::with_capacity(star.len());
+        let vertex_of: Vec<u32> = star
             .iter()
-            .map(|&(c, k, _)| {
-                let cell = e.cell(c);
-                let base = torus.position((position, cell.off[k]));
-                let mut a = [[0.0; D]; D];
-                let mut b = [0.0; D];
-                for (row, i) in (0..N).filter(|&i| i != k).enumerate() {
-                    let q = torus.position(e.lifted(c, i));
-                    let d: [f64; D] = std::array::from_fn(|x| q[x] - base[x]);
-                    a[row] = d;
-                    b[row] = 0.5 * dot(&d, &d);
-                }
-                solve(a, b)
-            })
-            .collect();
-        // adjacent star cells with one circumsphere are one Voronoi vertex
-        let mut parent: Vec<usize> = (0..star.len()).collect();
-        for (s, &(c, k, _)) in star.iter().enumerate() {
-            let cell = e.cell(c);
-            let lifted = e.lifted_cell(c);
-            for x in (0..N).filter(|&x| x != k) {
-                let d = cell.n[x];
-                let Some(t) = star.iter().position(|st| st.0 == d) else {
-                    continue;
-                };
-                if t < s {
-                    continue;
-                }
-                let dc = e.cell(d);
-                let y = (0..N)
-                    .find(|&y| dc.n[y] == c)
-                    .expect("symmetric neighbours");
-                let shift = e.translation(c, x, d);
-                let opposite = (self.points()[e.point_of(dc.v[y]) as usize], {
-                    torus.compose(dc.off[y], shift)
-                });
-                if torus.cospherical(&lifted, opposite) {
-                    let (a, b) = (root(&mut parent, s), root(&mut parent, t));
-                    parent[a.max(b)] = a.min(b);
-                }
-            }
-        }
-        let mut vertex_of = vec![u32::MAX; star.len()];
-        let mut vertices: Vec<[f64; D]> = Vec::new();
-        for s in 0..star.len() {
-            let r = root(&mut parent, s);
-            if vertex_of[r] == u32::MAX {
-                vertex_of[r] = vertices.len() as u32;
-                vertices.push(centers[r]);
-            }
-            vertex_of[s] = vertex_of[r];
-        }
-        // faces: the ring of star cells around each Delaunay edge at the point
-        let mut edges: Vec<(u32, [i8; D])> = Vec::new();
-        let mut ring_of: Vec<Vec<usize>> = Vec::new();
-        for (s, &(c, k, _)) in star.iter().enumerate() {
-            let cell = e.cell(c);
-            for j in (0..N).filter(|&j| j != k) {
-                let key = (cell.v[j], torus.difference(cell.off[j], cell.off[k]));
-                match edges.iter().position(|x| *x == key) {
-                    Some(f) => ring_of[f].push(s),
+            .map(|&(c, k)| {
+                let class = duals.class[c as usize];
+                match class_ids.iter().position(|&x| x == class) {
+                    Some(i) => i as u32,
                     None => {
-                        edges.push(key);
-                        ring_of.push(vec![s]);
+                        let base = torus.position((position, e.cell(c).off[k as usize]));
+                        let z = duals.center[c as usize];
+                        class_ids.push(class);
+                        vertices.push(std::array::from_fn(|x| z[x] - base[x]));
+                        vertices.len() as u32 - 1
                     }
                 }
+            })
+            .collect();
+        // faces: the ring of star cells around each Delaunay edge at the point
+        let mut edges: Vec<(u32, [i8; D])> = Vec::new();
+        let mut member: Vec<(u32, u32)> = Vec::with_capacity(star.len() * (N - 1));
+        for (s, &(c, k)) in star.iter().enumerate() {
+            let cell = e.cell(c);
+            for j in (0..N).filter(|&j| j != k as usize) {
+                let key = (
+                    cell.v[j],
+                    torus.difference(cell.off[j], cell.off[k as usize]),
+                );
+                let f = edges.iter().position(|x| *x == key).unwrap_or_else(|| {
+                    edges.push(key);
+                    edges.len() - 1
+                });
+                member.push((f as u32, s as u32));
             }
         }
+        member.sort_unstable();
         let mut faces = Vec::with_capacity(edges.len());
-        for (f, &(w, r)) in edges.iter().enumerate() {
-            let cycle = self.ring_cycle(&star, &ring_of[f], w, r);
+        for (f, ring) in member.chunk_by(|a, b| a.0 == b.0).enumerate() {
+            let (w, r) = edges[f];
+            let ring: Vec<usize> = ring.iter().map(|m| m.1 as usize).collect();
+            let cycle = self.ring_cycle(star, &ring, w, r);
             let mut ids: Vec<u32> = cycle.iter().map(|&s| vertex_of[s]).collect();
             ids.dedup();
             while ids.len() > 1 && ids.first() == ids.last() {
@@ -260,18 +330,13 @@ where
 
     /// The star cells around the Delaunay edge from the point to `(w, r)`, in cyclic order:
     /// consecutive cells share a facet holding both ends of the edge.
-    fn ring_cycle(
-        &self,
-        star: &[(u32, usize, [i8; D])],
-        ring: &[usize],
-        w: u32,
-        r: [i8; D],
-    ) -> Vec<usize> {
+    fn ring_cycle(&self, star: &[(u32, u8)], ring: &[usize], w: u32, r: [i8; D]) -> Vec<usize> {
         let e = self.engine();
         let mut cycle = vec![ring[0]];
         let mut prev = u32::MAX;
         loop {
-            let (c, k, _) = star[*cycle.last().unwrap()];
+            let (c, k) = star[*cycle.last().unwrap()];
+            let k = k as usize;
             let cell = e.cell(c);
             let j = (0..N)
                 .find(|&j| {
