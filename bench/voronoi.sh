@@ -34,15 +34,20 @@ from collections import defaultdict
 commit = sys.argv[2].split("=")[1]
 t = defaultdict(lambda: ([], [], []))
 for line in open(sys.argv[1]):
-    d = dict(kv.split("=", 1) for kv in line.split() if "=" in kv)
+    # first occurrence wins: the script's own keys come before the tool's (`input=` twice)
+    d = {}
+    for kv in line.split():
+        if "=" in kv:
+            k, v = kv.split("=", 1)
+            d.setdefault(k, v)
     if d.get("commit") != commit:
         continue
     k = (d["input"], int(d["N"]), int(d["threads"]))
     t[k][0].append(float(d["build_seconds"]))
     t[k][1].append(float(d["voronoi_seconds"]))
-    t[k][2].append(int(d["peak_rss_kb"]))
+    t[k][2].append(int(d.get("voronoi_peak_rss_kb", d["peak_rss_kb"])))
 print(f"commit {commit}")
-print("| input | N | threads | runs | build s | Voronoi s | µs/cell | Voronoi / build | peak RSS MiB |")
+print("| input | N | threads | runs | build s | Voronoi s | µs/cell | Voronoi / build | peak RSS MiB (after Voronoi) |")
 print("|---|---:|---:|---:|---:|---:|---:|---:|---:|")
 for (inp, n, th), (b, v, m) in sorted(t.items()):
     mb, mv = statistics.median(b), statistics.median(v)

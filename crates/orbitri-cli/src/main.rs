@@ -360,17 +360,29 @@ where
 {
     let pts: Vec<[f64; D]> = orbitri::io::read_points(input)?;
     let (tri, cost) = build(space, &pts)?;
-    let start = Instant::now();
-    let cells = tri.voronoi_cells();
-    let seconds = start.elapsed().as_secs_f64();
     let by_extension = args.output.as_ref().and_then(|p| {
         let ext = p.extension()?.to_str()?.to_ascii_lowercase();
         VoronoiFormat::from_str(&ext, true).ok()
     });
     let format = args.format.or(by_extension).unwrap_or(VoronoiFormat::Csv);
+    // whole cells only when an output needs their geometry; tables need their measures
+    let whole =
+        matches!(format, VoronoiFormat::Json | VoronoiFormat::Vtu) || args.neighbours.is_some();
+    let start = Instant::now();
+    let cells = if whole {
+        tri.voronoi_cells()
+    } else {
+        Vec::new()
+    };
+    let measures: Vec<orbitri::CellMeasures<D>> = if whole {
+        cells.iter().map(orbitri::CellMeasures::from).collect()
+    } else {
+        tri.voronoi_measures()
+    };
+    let seconds = start.elapsed().as_secs_f64();
     write_with(&args.output, |w| match format {
-        VoronoiFormat::Csv => orbitri::io::point_table(&tri, &cells).write_csv(w),
-        VoronoiFormat::Npy => w.write_all(&orbitri::io::point_table(&tri, &cells).npy()),
+        VoronoiFormat::Csv => orbitri::io::point_table(&tri, &measures).write_csv(w),
+        VoronoiFormat::Npy => w.write_all(&orbitri::io::point_table(&tri, &measures).npy()),
         VoronoiFormat::Json => orbitri::io::write_voronoi_json(w, &tri, &cells),
         VoronoiFormat::Vtu => orbitri::io::write_voronoi_vtu(w, &cells),
     })?;
@@ -384,11 +396,12 @@ where
         write_with(&args.edges, |w| orbitri::io::write_edges_csv(w, &tri))?;
     }
     if args.stats {
-        let total: f64 = cells.iter().map(|c| c.volume).sum();
+        let total: f64 = measures.iter().map(|c| c.volume).sum();
         eprintln!(
-            "{} voronoi_seconds={seconds:.6} volume_sum={total:?} domain_volume={:?}",
+            "{} voronoi_seconds={seconds:.6} volume_sum={total:?} domain_volume={:?} voronoi_peak_rss_kb={}",
             stats_line(&tri, pts.len(), &cost),
-            tri.space().lattice().volume()
+            tri.space().lattice().volume(),
+            rss::peak_kb().map_or("unknown".to_string(), |k| k.to_string())
         );
     }
     Ok(())

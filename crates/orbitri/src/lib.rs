@@ -34,4 +34,4 @@ pub use periodic::{
     PeriodicDelaunay3, Simplex,
 };
 pub use space::{FlatTorus, FlatTorus2, FlatTorus3, Ladder, Lattice, OrbitSpace};
-pub use voronoi::{Neighbor, VoronoiCell, VoronoiFace};
+pub use voronoi::{CellMeasures, Neighbor, VoronoiCell, VoronoiFace};

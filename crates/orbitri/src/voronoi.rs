@@ -42,6 +42,32 @@ pub struct VoronoiCell<const D: usize> {
     pub centroid: [f64; D],
 }
 
+/// What most users need of a cell, without its geometry (memory O(1) per point).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CellMeasures<const D: usize> {
+    /// Input id of the point (its first occurrence).
+    pub point: u32,
+    /// Volume (area in 2D).
+    pub volume: f64,
+    /// Number of faces (of neighbours, counting each image).
+    pub faces: u32,
+    /// Sum of the face areas (perimeter in 2D).
+    pub surface_area: f64,
+    pub centroid: [f64; D],
+}
+
+impl<const D: usize> From<&VoronoiCell<D>> for CellMeasures<D> {
+    fn from(c: &VoronoiCell<D>) -> Self {
+        CellMeasures {
+            point: c.point,
+            volume: c.volume,
+            faces: c.faces.len() as u32,
+            surface_area: c.faces.iter().map(|f| f.area).sum(),
+            centroid: c.centroid,
+        }
+    }
+}
+
 /// Two Voronoi neighbours: `j`'s image `points[j] + shift·M` shares a face of this area with
 /// `i`. Each unordered pair of images is listed once.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -133,15 +159,30 @@ where
     /// The Voronoi cells of the distinct points, in the order of their first occurrence
     /// (computed in parallel).
     pub fn voronoi_cells(&self) -> Vec<VoronoiCell<D>> {
+        self.per_cell(|c| c)
+    }
+
+    /// The measures of every distinct point's cell, in the order of first occurrence; the
+    /// cells themselves are dropped as soon as measured (for tables of millions of points).
+    pub fn voronoi_measures(&self) -> Vec<CellMeasures<D>> {
+        self.per_cell(|c| CellMeasures::from(&c))
+    }
+
+    /// `f` of every cell, computed in parallel in point order (the spatially sorted
+    /// insertion order: neighbouring points share triangulation cells in cache), returned in
+    /// the order of first occurrence.
+    fn per_cell<T: Send>(&self, f: impl Fn(VoronoiCell<D>) -> T + Sync) -> Vec<T> {
         let duals = self.duals();
-        // in point order, which is the spatially sorted insertion order: neighbouring points
-        // share cells in cache; then in input order
-        let mut cells: Vec<VoronoiCell<D>> = (0..self.number_of_vertices() as u32)
+        let mut out: Vec<Option<T>> = (0..self.number_of_vertices() as u32)
             .into_par_iter()
-            .map(|p| self.cell_of_point(&duals, p))
+            .map(|p| Some(f(self.cell_of_point(&duals, p))))
             .collect();
-        cells.sort_unstable_by_key(|c| c.point);
-        cells
+        let mut order: Vec<u32> = (0..out.len() as u32).collect();
+        order.sort_unstable_by_key(|&p| self.input_of_vertex(p));
+        order
+            .iter()
+            .map(|&p| out[p as usize].take().expect("each point once"))
+            .collect()
     }
 
     /// The Voronoi neighbour pairs with their shared face areas, each unordered pair of

@@ -431,6 +431,25 @@ fn volumes_sum_to_the_domain_and_duplicates_share_cells() {
     assert!((total - lattice.volume()).abs() <= 1e-12 * lattice.volume());
     check_pairs(&cells);
     assert_eq!(tri.voronoi_cell(20000), tri.voronoi_cell(5));
+    // the lean measures are the cells' own
+    let measures = tri.voronoi_measures();
+    assert_eq!(measures.len(), cells.len());
+    for (m, c) in measures.iter().zip(&cells) {
+        assert_eq!(*m, orbitri::CellMeasures::from(c));
+    }
+    // the Delaunay edges: each once, lengths are the lifted distances, E = V + C
+    let m = lattice.vectors();
+    let edges = tri.delaunay_edges();
+    assert_eq!(edges.len(), 20000 + tri.number_of_cells());
+    for e in edges.iter().take(500) {
+        let a = tri.points()[tri.vertex_of_input(e.i as usize) as usize];
+        let b = tri.points()[tri.vertex_of_input(e.j as usize) as usize];
+        let l: [f64; 3] = std::array::from_fn(|x| {
+            b[x] + (0..3).map(|k| e.shift[k] as f64 * m[k][x]).sum::<f64>() - a[x]
+        });
+        let d = (l[0] * l[0] + l[1] * l[1] + l[2] * l[2]).sqrt();
+        assert!((d - e.length).abs() <= 1e-12 * d);
+    }
     // each unordered pair once, and the pairs' areas are the faces' areas counted twice
     let pairs = tri.voronoi_neighbors();
     let faces: usize = cells.iter().map(|c| c.faces.len()).sum();

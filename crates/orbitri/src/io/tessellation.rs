@@ -9,29 +9,28 @@ use std::io::Write;
 use super::npy::encode_npy_matrix;
 use crate::periodic::{PeriodicDelaunay, Torus};
 use crate::space::FlatTorus;
-use crate::voronoi::{Neighbor, VoronoiCell};
+use crate::voronoi::{CellMeasures, Neighbor, VoronoiCell};
 use crate::Copies;
 
 const AXES: [&str; 3] = ["x", "y", "z"];
 
 /// The per-point table, one row per *input* point in input order: its cell's volume (area in
 /// 2D), number of faces, surface area (perimeter in 2D), centroid, and the input id of the
-/// first occurrence for a duplicate (which shares that cell), else `-1`. `cells` are the
-/// distinct points' cells (any order).
+/// first occurrence for a duplicate (which shares that cell), else `-1`.
 pub struct PointTable {
     pub columns: Vec<String>,
     pub rows: Vec<Vec<f64>>,
 }
 
-/// Builds the per-point table of a triangulation and its cells.
+/// Builds the per-point table of a triangulation from its cells' measures (any order).
 pub fn point_table<const D: usize, const N: usize>(
     tri: &PeriodicDelaunay<D, N>,
-    cells: &[VoronoiCell<D>],
+    cells: &[CellMeasures<D>],
 ) -> PointTable
 where
     FlatTorus<D>: Torus<D, N>,
 {
-    let by_point: HashMap<u32, &VoronoiCell<D>> = cells.iter().map(|c| (c.point, c)).collect();
+    let by_point: HashMap<u32, &CellMeasures<D>> = cells.iter().map(|c| (c.point, c)).collect();
     let first = tri.first_occurrences();
     let mut columns: Vec<String> = ["id", "volume", "neighbours", "surface_area"]
         .iter()
@@ -42,12 +41,7 @@ where
     let rows = (0..tri.number_of_input_points())
         .map(|i| {
             let c = by_point[&first[i]];
-            let mut row = vec![
-                i as f64,
-                c.volume,
-                c.faces.len() as f64,
-                c.faces.iter().map(|f| f.area).sum(),
-            ];
+            let mut row = vec![i as f64, c.volume, c.faces as f64, c.surface_area];
             row.extend_from_slice(&c.centroid);
             row.push(if first[i] as usize == i {
                 -1.0
