@@ -105,24 +105,6 @@ fn insertion_order_does_not_matter() {
     }
 }
 
-fn crystal(cells: usize, basis: &[[f64; 3]], a: f64) -> Vec<[f64; 3]> {
-    let mut out = Vec::new();
-    for i in 0..cells {
-        for j in 0..cells {
-            for k in 0..cells {
-                for b in basis {
-                    out.push([
-                        (i as f64 + b[0]) * a,
-                        (j as f64 + b[1]) * a,
-                        (k as f64 + b[2]) * a,
-                    ]);
-                }
-            }
-        }
-    }
-    out
-}
-
 #[test]
 fn crystal_lattices_with_inexact_coordinates() {
     // lattice constant 0.1 is not a binary fraction: every cospherical test is exact work

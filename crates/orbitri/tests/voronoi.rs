@@ -6,6 +6,9 @@
 
 use std::collections::BTreeSet;
 
+mod common;
+use common::crystal;
+
 use orbitri::sort::SplitMix;
 use orbitri::{
     FlatTorus, FlatTorus2, FlatTorus3, Lattice, PeriodicDelaunay2, PeriodicDelaunay3, VoronoiCell,
@@ -336,24 +339,6 @@ fn cells_equal_clipped_cells_in_2d() {
             }
         }
     }
-}
-
-fn crystal(cells: usize, basis: &[[f64; 3]], a: f64) -> Vec<[f64; 3]> {
-    let mut out = Vec::new();
-    for i in 0..cells {
-        for j in 0..cells {
-            for k in 0..cells {
-                for b in basis {
-                    out.push([
-                        (i as f64 + b[0]) * a,
-                        (j as f64 + b[1]) * a,
-                        (k as f64 + b[2]) * a,
-                    ]);
-                }
-            }
-        }
-    }
-    out
 }
 
 #[test]

@@ -185,6 +185,7 @@ where
 
 /// A VTK UnstructuredGrid in ASCII: 3D points (2D padded with z = 0), cells by VTK type,
 /// optional polyhedron face streams, and point and cell data arrays.
+#[derive(Default)]
 struct Vtu {
     points: Vec<[f64; 3]>,
     connectivity: Vec<u64>,
@@ -269,16 +270,7 @@ pub fn write_voronoi_vtu<const D: usize>(
     w: &mut impl Write,
     cells: &[VoronoiCell<D>],
 ) -> std::io::Result<()> {
-    let mut v = Vtu {
-        points: Vec::new(),
-        connectivity: Vec::new(),
-        offsets: Vec::new(),
-        types: Vec::new(),
-        faces: Vec::new(),
-        face_offsets: Vec::new(),
-        point_data: Vec::new(),
-        cell_data: Vec::new(),
-    };
+    let mut v = Vtu::default();
     let (mut ids, mut pid, mut vol) = (Vec::new(), Vec::new(), Vec::new());
     for c in cells {
         let base = v.points.len() as u64;
@@ -317,16 +309,7 @@ pub fn write_delaunay_vtu<const D: usize, const N: usize>(
 where
     FlatTorus<D>: Torus<D, N>,
 {
-    let mut v = Vtu {
-        points: Vec::new(),
-        connectivity: Vec::new(),
-        offsets: Vec::new(),
-        types: Vec::new(),
-        faces: Vec::new(),
-        face_offsets: Vec::new(),
-        point_data: Vec::new(),
-        cell_data: Vec::new(),
-    };
+    let mut v = Vtu::default();
     let mut index: HashMap<(u32, [i8; D]), u64> = HashMap::new();
     let mut pid = Vec::new();
     for c in tri.cells(Copies::Unique) {

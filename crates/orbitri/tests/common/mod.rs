@@ -227,3 +227,23 @@ pub fn read_dump(name: &str) -> ((usize, usize, usize), Vec<[i64; 16]>) {
             .collect(),
     )
 }
+
+/// `cells³` conventional cells of a cubic crystal with lattice constant `a` and the given
+/// basis (fractions of a cell).
+pub fn crystal(cells: usize, basis: &[[f64; 3]], a: f64) -> Vec<[f64; 3]> {
+    let mut out = Vec::new();
+    for i in 0..cells {
+        for j in 0..cells {
+            for k in 0..cells {
+                for b in basis {
+                    out.push([
+                        (i as f64 + b[0]) * a,
+                        (j as f64 + b[1]) * a,
+                        (k as f64 + b[2]) * a,
+                    ]);
+                }
+            }
+        }
+    }
+    out
+}
