@@ -390,6 +390,23 @@ where
         self.engine.cell_ids().map(|c| self.view(c))
     }
 
+    /// Every stored cell (as `stored_cells`) with its neighbours: `neighbors[k][i]` is the
+    /// position in this list of the cell opposite vertex `i` of cell `k`.
+    pub fn cells_with_neighbors(&self) -> (Vec<CellView<D, N>>, Vec<[u32; N]>) {
+        let ids: Vec<u32> = self.engine.cell_ids().collect();
+        let slots = ids.iter().max().map_or(0, |&m| m as usize + 1);
+        let mut position = vec![u32::MAX; slots];
+        for (k, &c) in ids.iter().enumerate() {
+            position[c as usize] = k as u32;
+        }
+        let views = ids.iter().map(|&c| self.view(c)).collect();
+        let neighbors = ids
+            .iter()
+            .map(|&c| self.engine.cell(c).n.map(|d| position[d as usize]))
+            .collect();
+        (views, neighbors)
+    }
+
     /// The cells with input ids and offsets: every stored cell, or one per orbit.
     pub fn cells(&self, copies: Copies) -> Vec<CellView<D, N>> {
         if copies == Copies::Stored || self.is_one_sheeted() {

@@ -1,0 +1,429 @@
+//! The Python extension `orbitri._orbitri`: the triangulation and its Voronoi cells for numpy
+//! arrays. The Python package (`python/orbitri`) parses boxes and documents the API; this
+//! module converts arrays (one copy of the input), releases the interpreter during
+//! construction, and turns errors into `ValueError` with the library's message.
+
+use numpy::ndarray::{Array1, Array2, Array3, ArrayView2};
+use numpy::{AllowTypeChange, IntoPyArray, PyArray1, PyArray2, PyArrayLike2};
+use orbitri::periodic::Torus;
+use orbitri::{FlatTorus, PeriodicDelaunay, PeriodicDelaunay2, PeriodicDelaunay3, VoronoiCell};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+fn value_error(e: orbitri::Error) -> PyErr {
+    PyValueError::new_err(e.to_string())
+}
+
+/// The rows of an `(N, D)` array as points (the one copy of the input).
+fn rows<const D: usize>(a: ArrayView2<'_, f64>) -> Vec<[f64; D]> {
+    a.outer_iter()
+        .map(|r| std::array::from_fn(|c| r[c]))
+        .collect()
+}
+
+fn matrix<const D: usize>(a: ArrayView2<'_, f64>) -> [[f64; D]; D] {
+    std::array::from_fn(|i| std::array::from_fn(|j| a[[i, j]]))
+}
+
+enum Tri {
+    Two(PeriodicDelaunay2),
+    Three(PeriodicDelaunay3),
+}
+
+/// Runs `$body` with `$t` bound to the triangulation of either dimension.
+macro_rules! with_tri {
+    ($tri:expr, $t:ident => $body:expr) => {
+        match $tri {
+            Tri::Two($t) => $body,
+            Tri::Three($t) => $body,
+        }
+    };
+}
+
+fn array2<T: numpy::Element>(
+    py: Python<'_>,
+    rows: usize,
+    cols: usize,
+    v: Vec<T>,
+) -> Bound<'_, PyArray2<T>> {
+    Array2::from_shape_vec((rows, cols), v)
+        .expect("shape matches")
+        .into_pyarray(py)
+}
+
+/// A periodic Delaunay triangulation (use `orbitri.PeriodicDelaunay`).
+#[pyclass(module = "orbitri._orbitri")]
+struct Triangulation {
+    tri: Tri,
+}
+
+fn build<const D: usize, const N: usize>(
+    py: Python<'_>,
+    points: Vec<[f64; D]>,
+    lattice: [[f64; D]; D],
+) -> PyResult<PeriodicDelaunay<D, N>>
+where
+    FlatTorus<D>: Torus<D, N>,
+{
+    py.detach(move || {
+        let torus = FlatTorus::<D>::triclinic(lattice)?;
+        PeriodicDelaunay::build(torus, &points)
+    })
+    .map_err(value_error)
+}
+
+fn simplices<const D: usize, const N: usize>(
+    py: Python<'_>,
+    t: &PeriodicDelaunay<D, N>,
+) -> (Py<PyAny>, Py<PyAny>, Py<PyAny>)
+where
+    FlatTorus<D>: Torus<D, N>,
+{
+    let (cells, nbrs) = t.cells_with_neighbors();
+    let c = cells.len();
+    let v: Vec<i64> = cells
+        .iter()
+        .flat_map(|x| x.vertices.map(i64::from))
+        .collect();
+    let o: Vec<i32> = cells
+        .iter()
+        .flat_map(|x| x.offsets.into_iter().flatten().map(i32::from))
+        .collect();
+    let n: Vec<i64> = nbrs.iter().flat_map(|x| x.map(i64::from)).collect();
+    (
+        array2(py, c, N, v).into_any().unbind(),
+        Array3::from_shape_vec((c, N, D), o)
+            .expect("shape matches")
+            .into_pyarray(py)
+            .into_any()
+            .unbind(),
+        array2(py, c, N, n).into_any().unbind(),
+    )
+}
+
+#[pymethods]
+impl Triangulation {
+    #[new]
+    fn new(
+        py: Python<'_>,
+        points: PyArrayLike2<'_, f64, AllowTypeChange>,
+        lattice: PyArrayLike2<'_, f64, AllowTypeChange>,
+    ) -> PyResult<Self> {
+        let p = points.as_array();
+        let l = lattice.as_array();
+        let d = p.shape()[1];
+        if l.shape() != [d, d] {
+            return Err(PyValueError::new_err(format!(
+                "the box of {d}-dimensional points must be a {d}×{d} lattice, not {:?}",
+                l.shape()
+            )));
+        }
+        let tri = match d {
+            2 => Tri::Two(build::<2, 3>(py, rows(p), matrix(l))?),
+            3 => Tri::Three(build::<3, 4>(py, rows(p), matrix(l))?),
+            _ => {
+                return Err(PyValueError::new_err(format!(
+                    "points must have 2 or 3 columns, not {d}"
+                )))
+            }
+        };
+        Ok(Triangulation { tri })
+    }
+
+    /// 2 or 3.
+    #[getter]
+    fn dimension(&self) -> usize {
+        with_tri!(&self.tri, t => t.space().lattice().vectors().len())
+    }
+
+    /// The lattice vectors (rows).
+    #[getter]
+    fn lattice<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        with_tri!(&self.tri, t => {
+            let m = t.space().lattice().vectors();
+            array2(py, m.len(), m.len(), m.iter().flatten().copied().collect())
+        })
+    }
+
+    /// The input points wrapped into the domain, in input order.
+    #[getter]
+    fn points<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        with_tri!(&self.tri, t => {
+            let n = t.number_of_input_points();
+            let v: Vec<f64> = (0..n)
+                .flat_map(|i| t.points()[t.vertex_of_input(i) as usize])
+                .collect();
+            array2(py, n, v.len() / n.max(1), v)
+        })
+    }
+
+    /// (simplices, offsets, neighbors) of every stored cell.
+    fn cells(&self, py: Python<'_>) -> (Py<PyAny>, Py<PyAny>, Py<PyAny>) {
+        with_tri!(&self.tri, t => simplices(py, t))
+    }
+
+    #[getter]
+    fn sheets(&self) -> usize {
+        with_tri!(&self.tri, t => t.sheets())
+    }
+
+    #[getter]
+    fn is_one_sheeted(&self) -> bool {
+        with_tri!(&self.tri, t => t.is_one_sheeted())
+    }
+
+    /// For every input point, the input id of its first occurrence.
+    #[getter]
+    fn duplicates<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<i64>> {
+        with_tri!(&self.tri, t => t.first_occurrences().into_iter().map(i64::from).collect::<Array1<i64>>().into_pyarray(py))
+    }
+
+    #[getter]
+    fn number_of_duplicates(&self) -> usize {
+        with_tri!(&self.tri, t => t.duplicates())
+    }
+
+    #[getter]
+    fn number_of_wrapped(&self) -> usize {
+        with_tri!(&self.tri, t => t.wrapped())
+    }
+
+    /// Inserts points; returns the input id each became or coincides with.
+    fn insert<'py>(
+        &mut self,
+        py: Python<'py>,
+        points: PyArrayLike2<'_, f64, AllowTypeChange>,
+    ) -> PyResult<Bound<'py, PyArray1<i64>>> {
+        let p = points.as_array();
+        let ids = with_tri!(&mut self.tri, t => {
+            let d = t.space().lattice().vectors().len();
+            if p.shape()[1] != d {
+                return Err(PyValueError::new_err(format!(
+                    "points must have {d} columns, not {}",
+                    p.shape()[1]
+                )));
+            }
+            let pts = rows(p);
+            let mut ids = Vec::with_capacity(pts.len());
+            for q in pts {
+                let r = t.insert(q).map_err(value_error)?;
+                let point = match r {
+                    orbitri::Inserted::New(v) | orbitri::Inserted::Duplicate(v) => v,
+                };
+                ids.push(i64::from(t.input_of_vertex(point)));
+            }
+            ids
+        });
+        Ok(Array1::from(ids).into_pyarray(py))
+    }
+
+    /// (vertices, offsets, point offset) of the cell containing a point.
+    fn locate(
+        &mut self,
+        py: Python<'_>,
+        point: Vec<f64>,
+    ) -> PyResult<(Py<PyAny>, Py<PyAny>, Py<PyAny>)> {
+        with_tri!(&mut self.tri, t => {
+            let d = t.space().lattice().vectors().len();
+            if point.len() != d {
+                return Err(PyValueError::new_err(format!(
+                    "a point has {d} coordinates, not {}",
+                    point.len()
+                )));
+            }
+            let q = std::array::from_fn(|c| point[c]);
+            let (cell, o) = t.locate(q).map_err(value_error)?;
+            let n = cell.vertices.len();
+            Ok((
+                cell.vertices.map(i64::from).to_vec().into_pyarray(py).into_any().unbind(),
+                array2(py, n, d, cell.offsets.iter().flatten().map(|&x| i32::from(x)).collect())
+                    .into_any()
+                    .unbind(),
+                o.map(i32::from).to_vec().into_pyarray(py).into_any().unbind(),
+            ))
+        })
+    }
+
+    /// (pairs E×2, shifts E×D, lengths E) of the Delaunay edges, each once.
+    fn edges(&self, py: Python<'_>) -> (Py<PyAny>, Py<PyAny>, Py<PyAny>) {
+        with_tri!(&self.tri, t => {
+            let e = t.delaunay_edges();
+            let d = t.space().lattice().vectors().len();
+            let ij: Vec<i64> = e.iter().flat_map(|x| [i64::from(x.i), i64::from(x.j)]).collect();
+            let s: Vec<i32> = e.iter().flat_map(|x| x.shift.map(i32::from)).collect();
+            let l: Vec<f64> = e.iter().map(|x| x.length).collect();
+            (
+                array2(py, e.len(), 2, ij).into_any().unbind(),
+                array2(py, e.len(), d, s).into_any().unbind(),
+                l.into_pyarray(py).into_any().unbind(),
+            )
+        })
+    }
+
+    /// (ids, shifts) of the Delaunay neighbours of input point `i`.
+    fn vertex_neighbors(&self, py: Python<'_>, i: usize) -> PyResult<(Py<PyAny>, Py<PyAny>)> {
+        with_tri!(&self.tri, t => {
+            if i >= t.number_of_input_points() {
+                return Err(PyValueError::new_err(format!(
+                    "point {i} does not exist ({} points)",
+                    t.number_of_input_points()
+                )));
+            }
+            let nb = t.vertex_neighbors(i);
+            let d = t.space().lattice().vectors().len();
+            let ids: Vec<i64> = nb.iter().map(|x| i64::from(x.0)).collect();
+            let s: Vec<i32> = nb.iter().flat_map(|x| x.1.map(i32::from)).collect();
+            Ok((
+                ids.into_pyarray(py).into_any().unbind(),
+                array2(py, nb.len(), d, s).into_any().unbind(),
+            ))
+        })
+    }
+
+    /// The Voronoi cells of the points (computed without holding the interpreter).
+    fn voronoi(&self, py: Python<'_>) -> Voronoi {
+        let cells = match &self.tri {
+            Tri::Two(t) => Cells::Two(py.detach(|| t.voronoi_cells()), t.first_occurrences()),
+            Tri::Three(t) => Cells::Three(py.detach(|| t.voronoi_cells()), t.first_occurrences()),
+        };
+        Voronoi { cells }
+    }
+}
+
+/// The cells of the distinct points (sorted by input id) and every input point's first
+/// occurrence.
+enum Cells {
+    Two(Vec<VoronoiCell<2>>, Vec<u32>),
+    Three(Vec<VoronoiCell<3>>, Vec<u32>),
+}
+
+macro_rules! with_cells {
+    ($cells:expr, $c:ident, $first:ident => $body:expr) => {
+        match $cells {
+            Cells::Two($c, $first) => $body,
+            Cells::Three($c, $first) => $body,
+        }
+    };
+}
+
+/// The cell of every input point (a duplicate's is its first occurrence's).
+fn per_input<const D: usize>(cells: &[VoronoiCell<D>], first: &[u32]) -> Vec<usize> {
+    first
+        .iter()
+        .map(|f| {
+            cells
+                .binary_search_by_key(f, |c| c.point)
+                .expect("every first occurrence has a cell")
+        })
+        .collect()
+}
+
+/// The periodic Voronoi cells of a triangulation (use `PeriodicDelaunay.voronoi()`).
+#[pyclass(module = "orbitri._orbitri")]
+struct Voronoi {
+    cells: Cells,
+}
+
+#[pymethods]
+impl Voronoi {
+    /// Volume (area in 2D) of every input point's cell.
+    #[getter]
+    fn volumes<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        with_cells!(&self.cells, c, first => per_input(c, first)
+            .into_iter()
+            .map(|k| c[k].volume)
+            .collect::<Array1<f64>>()
+            .into_pyarray(py))
+    }
+
+    /// Number of faces (neighbour images) of every input point's cell.
+    #[getter]
+    fn neighbor_counts<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<i64>> {
+        with_cells!(&self.cells, c, first => per_input(c, first)
+            .into_iter()
+            .map(|k| c[k].faces.len() as i64)
+            .collect::<Array1<i64>>()
+            .into_pyarray(py))
+    }
+
+    /// Surface area (perimeter in 2D) of every input point's cell.
+    #[getter]
+    fn surface_areas<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        with_cells!(&self.cells, c, first => per_input(c, first)
+            .into_iter()
+            .map(|k| c[k].faces.iter().map(|f| f.area).sum::<f64>())
+            .collect::<Array1<f64>>()
+            .into_pyarray(py))
+    }
+
+    /// Centroid of every input point's cell (Cartesian, near the point).
+    #[getter]
+    fn centroids<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        with_cells!(&self.cells, c, first => {
+            let idx = per_input(c, first);
+            let d = c.first().map_or(0, |x| x.centroid.len());
+            let v: Vec<f64> = idx.iter().flat_map(|&k| c[k].centroid).collect();
+            array2(py, idx.len(), d, v)
+        })
+    }
+
+    /// (pairs E×2, shifts E×D, areas E): each pair of neighbouring images once.
+    fn neighbors(&self, py: Python<'_>) -> (Py<PyAny>, Py<PyAny>, Py<PyAny>) {
+        with_cells!(&self.cells, c, _first => {
+            let pairs = orbitri::voronoi::neighbor_pairs(c);
+            let d = c.first().map_or(0, |x| x.centroid.len());
+            let ij: Vec<i64> = pairs.iter().flat_map(|p| [i64::from(p.i), i64::from(p.j)]).collect();
+            let s: Vec<i32> = pairs.iter().flat_map(|p| p.shift.map(i32::from)).collect();
+            let a: Vec<f64> = pairs.iter().map(|p| p.area).collect();
+            (
+                array2(py, pairs.len(), 2, ij).into_any().unbind(),
+                array2(py, pairs.len(), d, s).into_any().unbind(),
+                a.into_pyarray(py).into_any().unbind(),
+            )
+        })
+    }
+
+    /// Every distinct point's cell as a dict: id, position, volume, centroid, vertices
+    /// (K×D) and faces (dicts of vertices, neighbor, shift, area).
+    fn cells<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
+        with_cells!(&self.cells, c, _first => c.iter().map(|cell| {
+            let d = PyDict::new(py);
+            d.set_item("id", cell.point)?;
+            d.set_item("position", cell.position.to_vec())?;
+            d.set_item("volume", cell.volume)?;
+            d.set_item("centroid", cell.centroid.to_vec())?;
+            let dim = cell.position.len();
+            d.set_item(
+                "vertices",
+                array2(py, cell.vertices.len(), dim, cell.vertices.iter().flatten().copied().collect()),
+            )?;
+            let faces = cell
+                .faces
+                .iter()
+                .map(|f| {
+                    let fd = PyDict::new(py);
+                    fd.set_item("vertices", f.vertices.clone())?;
+                    fd.set_item("neighbor", f.neighbor)?;
+                    fd.set_item("shift", f.shift.to_vec())?;
+                    fd.set_item("area", f.area)?;
+                    Ok(fd)
+                })
+                .collect::<PyResult<Vec<_>>>()?;
+            d.set_item("faces", faces)?;
+            Ok(d)
+        }).collect())
+    }
+
+    fn __len__(&self) -> usize {
+        with_cells!(&self.cells, c, _first => c.len())
+    }
+}
+
+#[pymodule]
+fn _orbitri(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add_class::<Triangulation>()?;
+    m.add_class::<Voronoi>()?;
+    Ok(())
+}

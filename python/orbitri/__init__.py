@@ -1,0 +1,204 @@
+"""Exact periodic Delaunay triangulations and Voronoi cells of 2D and 3D point sets.
+
+The domain is a flat torus: a periodic box of any lattice. Every geometric decision is
+exact, and degenerate inputs (crystals, grids, duplicates) are handled, not rejected.
+
+>>> import numpy as np, orbitri
+>>> rng = np.random.default_rng(1)
+>>> points = rng.random((1000, 3)) * [2.0, 1.0, 1.0]
+>>> tri = orbitri.PeriodicDelaunay(points, [2.0, 1.0, 1.0])
+>>> tri.simplices.shape[1], tri.sheets
+(4, 1)
+>>> vor = tri.voronoi()
+>>> bool(abs(vor.volumes.sum() - 2.0) < 1e-12)
+True
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._orbitri import Triangulation as _Triangulation
+from ._orbitri import Voronoi, __version__
+
+__all__ = ["PeriodicDelaunay", "Voronoi", "lattice_matrix", "periodic_voronoi", "__version__"]
+
+
+def lattice_matrix(box, dimension: int) -> np.ndarray:
+    """The lattice of a box as a ``dimension × dimension`` matrix whose rows are the lattice
+    vectors. The domain is ``{f·M : f ∈ [0, 1)^D}``; points outside it are wrapped in.
+
+    ``box`` may be given as freud and ASE users give it:
+
+    * lengths ``[Lx, Ly, Lz]`` (or ``[Lx, Ly]``): an axis-aligned box;
+    * a ``D × D`` matrix whose rows are the lattice vectors (ASE's ``cell``);
+    * lengths and tilt factors ``[Lx, Ly, Lz, xy, xz, yz]`` (2D: ``[Lx, Ly, xy]``), as freud
+      defines them: ``a = (Lx, 0, 0)``, ``b = (xy·Ly, Ly, 0)``, ``c = (xz·Lz, yz·Lz, Lz)``.
+      LAMMPS's tilts are lengths: divide them by ``Ly`` (``xy``) or ``Lz`` (``xz``, ``yz``);
+    * a ``freud.box.Box`` (anything with ``to_matrix()``, whose columns are the vectors).
+
+    >>> lattice_matrix([2.0, 1.0, 1.0, 0.5, 0.0, 0.0], 3)[1]
+    array([0.5, 1. , 0. ])
+    """
+    if hasattr(box, "to_matrix"):
+        m = np.asarray(box.to_matrix(), dtype=float).T
+        if m.shape[0] == 3 and dimension == 2:
+            m = m[:2, :2]
+        box = m
+    b = np.asarray(box, dtype=float)
+    if b.ndim == 2:
+        if b.shape != (dimension, dimension):
+            raise ValueError(
+                f"a box matrix for {dimension}-dimensional points must be "
+                f"{dimension}×{dimension}, not {b.shape[0]}×{b.shape[1]}"
+            )
+        return np.ascontiguousarray(b)
+    if b.ndim != 1:
+        raise ValueError(f"a box is lengths, lengths and tilts, or a matrix; got shape {b.shape}")
+    lengths = b[:dimension]
+    if b.size in (dimension, 2 * dimension if dimension == 3 else 3):
+        for k, length in enumerate(lengths):
+            if not np.isfinite(length) or length <= 0:
+                raise ValueError(f"invalid box: length {k} is {length}; box lengths must be positive and finite")
+    if b.size == dimension:
+        return np.diag(b)
+    if dimension == 3 and b.size == 6:
+        lx, ly, lz, xy, xz, yz = b
+        return np.array([[lx, 0.0, 0.0], [xy * ly, ly, 0.0], [xz * lz, yz * lz, lz]])
+    if dimension == 2 and b.size == 3:
+        lx, ly, xy = b
+        return np.array([[lx, 0.0], [xy * ly, ly]])
+    tilts = "Lx, Ly, Lz, xy, xz, yz" if dimension == 3 else "Lx, Ly, xy"
+    raise ValueError(
+        f"a box for {dimension}-dimensional points has {dimension} lengths or [{tilts}], "
+        f"not {b.size} numbers"
+    )
+
+
+def _points(points) -> np.ndarray:
+    p = np.asarray(points, dtype=float)
+    if p.ndim != 2 or p.shape[1] not in (2, 3):
+        raise ValueError(f"points must be an array of shape (N, 2) or (N, 3), not {p.shape}")
+    return p
+
+
+class PeriodicDelaunay:
+    """The Delaunay triangulation of points in a periodic box (2D or 3D, from the points'
+    shape), exact for every input.
+
+    Points outside the box are wrapped into it; a point that coincides with an earlier one
+    (also through a period) is a duplicate: it maps to its first occurrence and is listed in
+    ``duplicates``. Construction runs without holding the interpreter.
+
+    Arrays follow ``scipy.spatial.Delaunay``: ``simplices`` (C × (D+1) input ids, positively
+    oriented), ``offsets`` (C × (D+1) × D: vertex ``k`` of simplex ``c`` lies at
+    ``points[simplices[c, k]] + offsets[c, k] @ lattice``), ``neighbors`` (C × (D+1): the
+    simplex opposite each vertex). While the points are too few for the torus
+    (``sheets > 1``), these list every simplex of the covering space.
+
+    >>> import orbitri
+    >>> tri = orbitri.PeriodicDelaunay([[0.1, 0.2], [0.6, 0.4], [0.3, 0.8], [0.8, 0.9]] * 10
+    ...                                + [[0.05 * i, 0.5] for i in range(20)], [1.0, 1.0])
+    >>> int(tri.duplicates[4]), tri.simplices.shape[1]
+    (0, 3)
+    """
+
+    def __init__(self, points, box):
+        p = _points(points)
+        self._tri = _Triangulation(p, lattice_matrix(box, p.shape[1]))
+        self._cells = None
+
+    def _arrays(self):
+        if self._cells is None:
+            self._cells = self._tri.cells()
+        return self._cells
+
+    @property
+    def dimension(self) -> int:
+        """2 or 3."""
+        return self._tri.dimension
+
+    @property
+    def lattice(self) -> np.ndarray:
+        """The lattice vectors (rows)."""
+        return self._tri.lattice
+
+    @property
+    def points(self) -> np.ndarray:
+        """The input points wrapped into the domain (N × D), in input order."""
+        return self._tri.points
+
+    @property
+    def simplices(self) -> np.ndarray:
+        """Input ids of the vertices of every simplex (C × (D+1))."""
+        return self._arrays()[0]
+
+    @property
+    def offsets(self) -> np.ndarray:
+        """Lattice offsets of the simplices' vertices (C × (D+1) × D)."""
+        return self._arrays()[1]
+
+    @property
+    def neighbors(self) -> np.ndarray:
+        """The simplex opposite each vertex of every simplex (C × (D+1))."""
+        return self._arrays()[2]
+
+    @property
+    def sheets(self) -> int:
+        """1 once the triangulation is one of the torus; more for too few points."""
+        return self._tri.sheets
+
+    @property
+    def is_one_sheeted(self) -> bool:
+        return self._tri.is_one_sheeted
+
+    @property
+    def duplicates(self) -> np.ndarray:
+        """For every input point, the input id of its first occurrence (itself if none)."""
+        return self._tri.duplicates
+
+    @property
+    def number_of_duplicates(self) -> int:
+        return self._tri.number_of_duplicates
+
+    @property
+    def number_of_wrapped(self) -> int:
+        """How many input points were outside the domain and wrapped into it."""
+        return self._tri.number_of_wrapped
+
+    def insert(self, points) -> np.ndarray:
+        """Inserts more points (their input ids follow the existing ones); returns for each
+        the input id of the vertex it became or coincides with."""
+        self._cells = None
+        return self._tri.insert(_points(points))
+
+    def locate(self, point):
+        """The simplex containing ``point``: (vertex ids, their offsets, the point's offset
+        in that simplex's frame)."""
+        return self._tri.locate([float(x) for x in point])
+
+    def edges(self):
+        """The Delaunay edges, each once: (pairs E × 2, shifts E × D, lengths E); the
+        second point's image is ``points[j] + shift @ lattice``."""
+        return self._tri.edges()
+
+    def vertex_neighbors(self, i: int):
+        """The Delaunay neighbours of input point ``i``: (ids, shifts)."""
+        return self._tri.vertex_neighbors(int(i))
+
+    def voronoi(self) -> Voronoi:
+        """The periodic Voronoi cells (volumes, neighbours with shifts and face areas,
+        centroids, and the cells themselves on demand)."""
+        return self._tri.voronoi()
+
+
+def periodic_voronoi(points, box) -> Voronoi:
+    """The periodic Voronoi cells of points in a box: ``PeriodicDelaunay(points,
+    box).voronoi()``.
+
+    >>> import numpy as np, orbitri
+    >>> vor = orbitri.periodic_voronoi(np.random.default_rng(2).random((500, 2)), [1.0, 1.0])
+    >>> len(vor), bool(abs(vor.volumes.sum() - 1.0) < 1e-12)
+    (500, True)
+    """
+    return PeriodicDelaunay(points, box).voronoi()
