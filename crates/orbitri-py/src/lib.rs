@@ -6,7 +6,9 @@
 use numpy::ndarray::{Array1, Array2, Array3, ArrayView2};
 use numpy::{AllowTypeChange, IntoPyArray, PyArray1, PyArray2, PyArrayLike2};
 use orbitri::periodic::Torus;
-use orbitri::{FlatTorus, PeriodicDelaunay, PeriodicDelaunay2, PeriodicDelaunay3, VoronoiCell};
+use orbitri::{
+    CellMeasures, FlatTorus, PeriodicDelaunay, PeriodicDelaunay2, PeriodicDelaunay3, VoronoiCell,
+};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -37,6 +39,17 @@ macro_rules! with_tri {
         match $tri {
             Tri::Two($t) => $body,
             Tri::Three($t) => $body,
+        }
+    };
+}
+
+/// Runs `$body` with `$c` bound to the cells of either dimension and `$first` to the first
+/// occurrences.
+macro_rules! with_cells {
+    ($cells:expr, $c:ident, $first:ident => $body:expr) => {
+        match $cells {
+            Cells::Two($c, $first) => $body,
+            Cells::Three($c, $first) => $body,
         }
     };
 }
@@ -287,7 +300,8 @@ impl Triangulation {
             Tri::Two(t) => Cells::Two(py.detach(|| t.voronoi_cells()), t.first_occurrences()),
             Tri::Three(t) => Cells::Three(py.detach(|| t.voronoi_cells()), t.first_occurrences()),
         };
-        Voronoi { cells }
+        let per_point = with_cells!(&cells, c, first => PerPoint::of(c, first));
+        Voronoi { cells, per_point }
     }
 }
 
@@ -296,15 +310,6 @@ impl Triangulation {
 enum Cells {
     Two(Vec<VoronoiCell<2>>, Vec<u32>),
     Three(Vec<VoronoiCell<3>>, Vec<u32>),
-}
-
-macro_rules! with_cells {
-    ($cells:expr, $c:ident, $first:ident => $body:expr) => {
-        match $cells {
-            Cells::Two($c, $first) => $body,
-            Cells::Three($c, $first) => $body,
-        }
-    };
 }
 
 /// The cell of every input point (a duplicate's is its first occurrence's).
@@ -319,10 +324,37 @@ fn per_input<const D: usize>(cells: &[VoronoiCell<D>], first: &[u32]) -> Vec<usi
         .collect()
 }
 
+/// Every input point's cell measures (a duplicate's are its first occurrence's).
+struct PerPoint {
+    volumes: Vec<f64>,
+    counts: Vec<i64>,
+    surfaces: Vec<f64>,
+    /// N × D, flat.
+    centroids: Vec<f64>,
+    dimension: usize,
+}
+
+impl PerPoint {
+    fn of<const D: usize>(cells: &[VoronoiCell<D>], first: &[u32]) -> Self {
+        let m: Vec<CellMeasures<D>> = per_input(cells, first)
+            .into_iter()
+            .map(|k| CellMeasures::from(&cells[k]))
+            .collect();
+        PerPoint {
+            volumes: m.iter().map(|x| x.volume).collect(),
+            counts: m.iter().map(|x| i64::from(x.faces)).collect(),
+            surfaces: m.iter().map(|x| x.surface_area).collect(),
+            centroids: m.iter().flat_map(|x| x.centroid).collect(),
+            dimension: D,
+        }
+    }
+}
+
 /// The periodic Voronoi cells of a triangulation (use `PeriodicDelaunay.voronoi()`).
 #[pyclass(module = "orbitri._orbitri")]
 struct Voronoi {
     cells: Cells,
+    per_point: PerPoint,
 }
 
 #[pymethods]
@@ -330,42 +362,26 @@ impl Voronoi {
     /// Volume (area in 2D) of every input point's cell.
     #[getter]
     fn volumes<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        with_cells!(&self.cells, c, first => per_input(c, first)
-            .into_iter()
-            .map(|k| c[k].volume)
-            .collect::<Array1<f64>>()
-            .into_pyarray(py))
+        self.per_point.volumes.clone().into_pyarray(py)
     }
 
     /// Number of faces (neighbour images) of every input point's cell.
     #[getter]
     fn neighbor_counts<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<i64>> {
-        with_cells!(&self.cells, c, first => per_input(c, first)
-            .into_iter()
-            .map(|k| c[k].faces.len() as i64)
-            .collect::<Array1<i64>>()
-            .into_pyarray(py))
+        self.per_point.counts.clone().into_pyarray(py)
     }
 
     /// Surface area (perimeter in 2D) of every input point's cell.
     #[getter]
     fn surface_areas<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        with_cells!(&self.cells, c, first => per_input(c, first)
-            .into_iter()
-            .map(|k| c[k].faces.iter().map(|f| f.area).sum::<f64>())
-            .collect::<Array1<f64>>()
-            .into_pyarray(py))
+        self.per_point.surfaces.clone().into_pyarray(py)
     }
 
     /// Centroid of every input point's cell (Cartesian, near the point).
     #[getter]
     fn centroids<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        with_cells!(&self.cells, c, first => {
-            let idx = per_input(c, first);
-            let d = c.first().map_or(0, |x| x.centroid.len());
-            let v: Vec<f64> = idx.iter().flat_map(|&k| c[k].centroid).collect();
-            array2(py, idx.len(), d, v)
-        })
+        let p = &self.per_point;
+        array2(py, p.volumes.len(), p.dimension, p.centroids.clone())
     }
 
     /// (pairs E×2, shifts E×D, areas E): each pair of neighbouring images once.
