@@ -5,6 +5,7 @@ use std::fmt::Write as _;
 use std::io::Write;
 
 use crate::periodic::PeriodicDelaunay2;
+use crate::space::Lattice;
 
 /// What to draw.
 #[derive(Clone, Copy, Debug)]
@@ -31,8 +32,8 @@ impl Default for SvgOptions {
     }
 }
 
-/// A Cartesian segment or point set with its extent in fractional coordinates, to be drawn
-/// at every lattice translation that brings it into the window.
+/// A Cartesian polyline or point with its extent in fractional coordinates, to be drawn at
+/// every lattice translation that brings it into the window.
 struct Shape {
     pts: Vec<[f64; 2]>,
     fmin: [f64; 2],
@@ -41,16 +42,16 @@ struct Shape {
 
 /// The page: the window in fractional coordinates `[lo, hi)²`, the lattice, and the map
 /// from Cartesian coordinates to pixels (y up).
-struct Page {
+struct Page<'a> {
     lo: f64,
     hi: f64,
-    m: [[f64; 2]; 2],
+    lattice: &'a Lattice<2>,
     origin: [f64; 2],
     top: f64,
     scale: f64,
 }
 
-impl Page {
+impl Page<'_> {
     fn px(&self, p: [f64; 2]) -> (f64, f64) {
         (
             (p[0] - self.origin[0]) * self.scale,
@@ -59,26 +60,35 @@ impl Page {
     }
 
     fn cart(&self, f: [f64; 2]) -> [f64; 2] {
-        [
-            f[0] * self.m[0][0] + f[1] * self.m[1][0],
-            f[0] * self.m[0][1] + f[1] * self.m[1][1],
-        ]
+        self.lattice.cartesian(&f)
+    }
+
+    /// A polyline or point, with its extent in fractional coordinates.
+    fn shape(&self, pts: Vec<[f64; 2]>) -> Shape {
+        let mut fmin = [f64::INFINITY; 2];
+        let mut fmax = [f64::NEG_INFINITY; 2];
+        for p in &pts {
+            let f = self.lattice.fractional(p);
+            for c in 0..2 {
+                fmin[c] = fmin[c].min(f[c]);
+                fmax[c] = fmax[c].max(f[c]);
+            }
+        }
+        Shape { pts, fmin, fmax }
     }
 
     /// Every translation `t` with `[fmin + t, fmax + t]` meeting the window.
-    fn translations(&self, s: &Shape) -> impl Iterator<Item = [f64; 2]> {
+    fn translations(&self, s: &Shape) -> impl Iterator<Item = [f64; 2]> + '_ {
         let range = |c: usize| {
             let a = (self.lo - s.fmax[c]).ceil() as i64;
             let b = (self.hi - s.fmin[c]).floor() as i64;
             a..=b
         };
         let (rx, ry) = (range(0), range(1));
-        let m = self.m;
+        let lattice = self.lattice;
         rx.flat_map(move |i| {
-            ry.clone().map(move |j| {
-                let (i, j) = (i as f64, j as f64);
-                [i * m[0][0] + j * m[1][0], i * m[0][1] + j * m[1][1]]
-            })
+            ry.clone()
+                .map(move |j| lattice.cartesian(&[i as f64, j as f64]))
         })
     }
 
@@ -97,71 +107,30 @@ impl Page {
     }
 }
 
-fn shape(tri: &PeriodicDelaunay2, pts: Vec<[f64; 2]>) -> Shape {
-    let lattice = tri.space().lattice();
-    let mut fmin = [f64::INFINITY; 2];
-    let mut fmax = [f64::NEG_INFINITY; 2];
-    for p in &pts {
-        let f = lattice.fractional(p);
-        for c in 0..2 {
-            fmin[c] = fmin[c].min(f[c]);
-            fmax[c] = fmax[c].max(f[c]);
-        }
-    }
-    Shape { pts, fmin, fmax }
-}
-
-/// Circumcenter of a triangle (Cartesian).
-pub(crate) fn circumcenter(p: [[f64; 2]; 3]) -> [f64; 2] {
-    let (ax, ay) = (p[1][0] - p[0][0], p[1][1] - p[0][1]);
-    let (bx, by) = (p[2][0] - p[0][0], p[2][1] - p[0][1]);
-    let d = 2.0 * (ax * by - ay * bx);
-    let (la, lb) = (ax * ax + ay * ay, bx * bx + by * by);
-    [
-        p[0][0] + (by * la - ay * lb) / d,
-        p[0][1] + (ax * lb - bx * la) / d,
-    ]
-}
-
-/// The Delaunay edges (one per orbit) as segments.
-fn delaunay_edges(tri: &PeriodicDelaunay2) -> Vec<Shape> {
-    let torus = tri.space();
-    tri.edges(crate::Copies::Unique)
+/// The Delaunay edges (one per orbit) as segments from the library's edge list.
+fn delaunay_edges(page: &Page, tri: &PeriodicDelaunay2) -> Vec<Shape> {
+    let at = |i: u32| tri.points()[tri.vertex_of_input(i as usize) as usize];
+    tri.delaunay_edges()
         .into_iter()
         .map(|e| {
-            let pts = (0..2)
-                .map(|k| {
-                    let v = tri.vertex_of_input(e.vertices[k] as usize);
-                    torus.position((tri.points()[v as usize], e.offsets[k]))
-                })
-                .collect();
-            shape(tri, pts)
+            let (a, b) = (at(e.i), at(e.j));
+            let t = page.lattice.cartesian(&e.shift.map(f64::from));
+            page.shape(vec![a, [b[0] + t[0], b[1] + t[1]]])
         })
         .collect()
 }
 
-/// The Voronoi edges: for each pair of adjacent stored triangles, the segment between their
-/// circumcenters, the neighbour's moved into the triangle's frame.
-fn voronoi_edges(tri: &PeriodicDelaunay2) -> Vec<Shape> {
-    let e = tri.engine();
-    let torus = tri.space();
-    let center = |c: u32| circumcenter(e.lifted_cell(c).map(|l| torus.position(l)));
-    let mut out = Vec::new();
-    for c in e.cell_ids() {
-        let cell = e.cell(c);
-        for i in 0..3 {
-            let d = cell.n[i];
-            if d < c {
-                continue;
-            }
-            let t = e.translation(c, i, d);
-            let shift = torus.position(([0.0; 2], t));
-            let a = center(c);
-            let b = center(d);
-            out.push(shape(tri, vec![a, [b[0] + shift[0], b[1] + shift[1]]]));
-        }
-    }
-    out
+/// The Voronoi cells as closed polygons (the library's exact cells: every edge is drawn
+/// from both of its cells).
+fn voronoi_cells(page: &Page, tri: &PeriodicDelaunay2) -> Vec<Shape> {
+    tri.voronoi_cells()
+        .into_iter()
+        .map(|c| {
+            let mut pts = c.vertices;
+            pts.push(pts[0]);
+            page.shape(pts)
+        })
+        .collect()
 }
 
 /// Writes the picture as SVG.
@@ -172,11 +141,10 @@ pub fn write_svg(
 ) -> std::io::Result<()> {
     let k = opts.copies.max(1) as f64;
     let lo = -f64::from((opts.copies.max(1) - 1) / 2);
-    let m = tri.space().lattice().vectors();
     let mut page = Page {
         lo,
         hi: lo + k,
-        m,
+        lattice: tri.space().lattice(),
         origin: [0.0; 2],
         top: 0.0,
         scale: 1.0,
@@ -224,7 +192,7 @@ pub fn write_svg(
         writeln!(
             w,
             r##"<path id="voronoi" stroke="#c8553d" stroke-width="{stroke:.2}" d="{}"/>"##,
-            page.path(&voronoi_edges(tri))
+            page.path(&voronoi_cells(&page, tri))
         )?;
     }
     if opts.delaunay {
@@ -232,14 +200,14 @@ pub fn write_svg(
             w,
             r##"<path id="delaunay" stroke="#2a6f97" stroke-width="{:.2}" d="{}"/>"##,
             stroke * 0.8,
-            page.path(&delaunay_edges(tri))
+            page.path(&delaunay_edges(&page, tri))
         )?;
     }
     if opts.points {
         let r = (stroke * 2.0).max(0.8);
         let mut pts = String::new();
         for p in tri.points() {
-            let s = shape(tri, vec![*p]);
+            let s = page.shape(vec![*p]);
             for t in page.translations(&s) {
                 let (x, y) = page.px([p[0] + t[0], p[1] + t[1]]);
                 let fill = if t == [0.0, 0.0] { "#111" } else { "#777" };
