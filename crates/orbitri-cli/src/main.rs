@@ -304,18 +304,11 @@ where
 {
     let pts: Vec<[f64; D]> = orbitri::io::read_points(input)?;
     let (tri, cost) = build(space, &pts)?;
-    let path = out
-        .output
-        .clone()
-        .unwrap_or_else(|| PathBuf::from("<stdout>"));
-    let mut w = writer(&out.output)?;
-    let res = match out.format {
-        Format::Cells => orbitri::io::write_cells(&mut w, &tri),
-        Format::Json => orbitri::io::write_json(&mut w, &tri),
-        Format::Vtu => orbitri::io::write_delaunay_vtu(&mut w, &tri),
-    };
-    res.and_then(|_| w.flush())
-        .map_err(|source| CliError::Write { path, source })?;
+    write_with(&out.output, |w| match out.format {
+        Format::Cells => orbitri::io::write_cells(w, &tri),
+        Format::Json => orbitri::io::write_json(w, &tri),
+        Format::Vtu => orbitri::io::write_delaunay_vtu(w, &tri),
+    })?;
     if out.stats {
         eprintln!("{}", stats_line(&tri, pts.len(), &cost));
     }
@@ -562,9 +555,7 @@ fn demo(n: usize, seed: u64) -> Result<(), CliError> {
 }
 
 fn generate(n: usize, seed: u64, dim: u8, output: Option<PathBuf>) -> Result<(), CliError> {
-    let path = output.clone().unwrap_or_else(|| PathBuf::from("<stdout>"));
-    let mut w = writer(&output)?;
-    let res = (|| {
+    write_with(&output, |w| {
         if dim == 2 {
             for p in uniform::<2>(n, seed) {
                 writeln!(w, "{:?} {:?}", p[0], p[1])?;
@@ -574,9 +565,8 @@ fn generate(n: usize, seed: u64, dim: u8, output: Option<PathBuf>) -> Result<(),
                 writeln!(w, "{:?} {:?} {:?}", p[0], p[1], p[2])?;
             }
         }
-        w.flush()
-    })();
-    res.map_err(|source| CliError::Write { path, source })
+        Ok(())
+    })
 }
 
 fn main() -> ExitCode {
