@@ -95,11 +95,21 @@ pub fn write_neighbors_csv<const D: usize>(
     w: &mut impl Write,
     pairs: &[Neighbor<D>],
 ) -> std::io::Result<()> {
+    let rows = pairs.iter().map(|p| (p.i, p.j, p.shift, p.area));
+    write_pairs_csv(w, "area", rows)
+}
+
+/// Rows `i,j,shift_x,shift_y[,shift_z],VALUE` under a header naming the value column.
+fn write_pairs_csv<const D: usize>(
+    w: &mut impl Write,
+    value: &str,
+    rows: impl Iterator<Item = (u32, u32, [i8; D], f64)>,
+) -> std::io::Result<()> {
     let shifts: Vec<String> = (0..D).map(|k| format!("shift_{}", AXES[k])).collect();
-    writeln!(w, "i,j,{},area", shifts.join(","))?;
-    for p in pairs {
-        let s: Vec<String> = p.shift.iter().map(|x| x.to_string()).collect();
-        writeln!(w, "{},{},{},{:?}", p.i, p.j, s.join(","), p.area)?;
+    writeln!(w, "i,j,{},{value}", shifts.join(","))?;
+    for (i, j, shift, x) in rows {
+        let s: Vec<String> = shift.iter().map(|x| x.to_string()).collect();
+        writeln!(w, "{i},{j},{},{x:?}", s.join(","))?;
     }
     Ok(())
 }
@@ -113,13 +123,11 @@ pub fn write_edges_csv<const D: usize, const N: usize>(
 where
     FlatTorus<D>: Torus<D, N>,
 {
-    let shifts: Vec<String> = (0..D).map(|k| format!("shift_{}", AXES[k])).collect();
-    writeln!(w, "i,j,{},length", shifts.join(","))?;
-    for e in tri.delaunay_edges() {
-        let s: Vec<String> = e.shift.iter().map(|x| x.to_string()).collect();
-        writeln!(w, "{},{},{},{:?}", e.i, e.j, s.join(","), e.length)?;
-    }
-    Ok(())
+    let rows = tri
+        .delaunay_edges()
+        .into_iter()
+        .map(|e| (e.i, e.j, e.shift, e.length));
+    write_pairs_csv(w, "length", rows)
 }
 
 fn json_point(p: &[f64]) -> String {
