@@ -162,12 +162,13 @@ impl Triangulation {
     /// The input points wrapped into the domain, in input order.
     #[getter]
     fn points<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        let d = self.dimension();
         with_tri!(&self.tri, t => {
             let n = t.number_of_input_points();
             let v: Vec<f64> = (0..n)
                 .flat_map(|i| t.points()[t.vertex_of_input(i) as usize])
                 .collect();
-            array2(py, n, v.len() / n.max(1), v)
+            array2(py, n, d, v)
         })
     }
 

@@ -152,6 +152,8 @@ where
     FlatTorus<D>: Torus<D, N>,
 {
     /// The Voronoi cell of input point `i` (a duplicate gets its first occurrence's cell).
+    /// It computes the circumcenters and cospherical classes of the whole triangulation
+    /// first: for many cells, call [`Self::voronoi_cells`] once.
     pub fn voronoi_cell(&self, i: usize) -> VoronoiCell<D> {
         self.cell_of_point(&self.duals(), self.vertex_of_input(i))
     }
