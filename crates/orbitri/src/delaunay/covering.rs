@@ -37,9 +37,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             .flat_map(|p| std::iter::repeat_n(p, sheets))
             .collect();
         self.vcell = vec![NONE; self.vpoint.len()];
-        self.big_limit = self
-            .space
-            .criterion_radius2((level + 1).min(self.last_level()));
+        self.big_limit = self.next_limit();
         self.big.clear();
         self.big_count = 0;
         self.hint = NONE;

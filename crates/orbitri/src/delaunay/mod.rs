@@ -328,11 +328,17 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.guaranteed = holds;
     }
 
+    /// The squared circumradius that makes a cell big: the criterion of the level after the
+    /// current one (of the quotient once there).
+    pub(super) fn next_limit(&self) -> f64 {
+        let target = (self.level + 1).min(self.last_level());
+        self.space.criterion_radius2(target)
+    }
+
     /// Examines every cell against the criterion of the level after the current one (of the
     /// quotient once there).
     fn recount_big(&mut self) {
-        let target = (self.level + 1).min(self.last_level());
-        self.big_limit = self.space.criterion_radius2(target);
+        self.big_limit = self.next_limit();
         self.big.clear();
         self.big_count = 0;
         let ids: Vec<u32> = self.tds.ids().collect();

@@ -27,8 +27,6 @@ pub(super) type L<const D: usize> = Lifted<[f64; D], [i8; D]>;
 pub struct FlatTorus<const D: usize> {
     pub(super) lattice: Lattice<D>,
     ladder: Vec<Level<D>>,
-    /// Per level: the squared circumradius below which every cell allows that level.
-    criterion_r2: Vec<f64>,
 }
 
 /// The 2D flat torus.
@@ -68,25 +66,7 @@ impl<const D: usize> FlatTorus<D> {
     /// The torus of a lattice with a chosen covering ladder.
     pub fn with_ladder(lattice: Lattice<D>, kind: Ladder) -> Self {
         let ladder = lattice.ladder(kind);
-        // Cells with circumradius < δ(H)/4 satisfy Δ < δ(H)/2; keep a relative margin far
-        // above the rounding error of the approximate circumradius. Level 0 needs no test.
-        let criterion_r2 = ladder
-            .iter()
-            .enumerate()
-            .map(|(k, l)| {
-                let r = l.systole / 4.0 * (1.0 - 1e-7);
-                if k == 0 {
-                    f64::INFINITY
-                } else {
-                    r * r
-                }
-            })
-            .collect();
-        FlatTorus {
-            lattice,
-            ladder,
-            criterion_r2,
-        }
+        FlatTorus { lattice, ladder }
     }
 
     /// The coverings of the ladder, from level 0 (most sheets) to the torus.
@@ -241,8 +221,15 @@ impl<const D: usize> FlatTorus<D> {
         self.compare_lifted(a, b) == Sign::Zero
     }
 
+    /// The squared circumradius below which every cell allows `level`. Cells with
+    /// circumradius < δ(H)/4 satisfy Δ < δ(H)/2; the relative margin is far above the rounding
+    /// error of the approximate circumradius. Level 0 needs no test.
     pub(super) fn criterion_r2(&self, level: usize) -> f64 {
-        self.criterion_r2[level]
+        if level == 0 {
+            return f64::INFINITY;
+        }
+        let r = self.ladder[level].systole / 4.0 * (1.0 - 1e-7);
+        r * r
     }
 
     pub(super) fn copies(&self, level: usize) -> Vec<[i8; D]> {
