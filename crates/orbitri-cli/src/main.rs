@@ -351,6 +351,7 @@ fn voronoi_in<const D: usize, const N: usize>(
 where
     FlatTorus<D>: Torus<D, N>,
 {
+    space.lattice().check_volume_representable()?;
     let pts: Vec<[f64; D]> = orbitri::io::read_points(input)?;
     let (tri, cost) = build(space, &pts)?;
     let by_extension = args.output.as_ref().and_then(|p| {

@@ -471,3 +471,74 @@ fn voronoi_tables_cells_and_vtk() {
     // id, volume, neighbours, surface, centroid x y, duplicate_of
     assert!(header.contains("'shape': (50, 7)"), "{header}");
 }
+
+#[test]
+fn extreme_and_elongated_boxes() {
+    let dir = tempfile::tempdir().unwrap();
+    // one point in a box of 1e100 (it panicked), its cells in the 27-sheeted covering
+    let one = write(dir.path(), "one.txt", "3e99 1e99 7e99\n");
+    let o = orbitri(&[
+        "triangulate",
+        one.to_str().unwrap(),
+        "--box",
+        "1e100",
+        "1e100",
+        "1e100",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(String::from_utf8_lossy(&o.stdout).starts_with("27 1 "));
+    // the same cells at 1e-100 and in the unit box, scaled by powers of ten the doubles
+    // cannot scale exactly: compare the unit box with its power-of-two scalings instead
+    let pts = write(dir.path(), "pts.txt", "0.25 0.5\n0.75 0.125\n0.5 0.875\n");
+    let small = write(
+        dir.path(),
+        "small.txt",
+        &format!(
+            "{:e} {:e}\n{:e} {:e}\n{:e} {:e}\n",
+            0.25 * 2f64.powi(-400),
+            0.5 * 2f64.powi(-400),
+            0.75 * 2f64.powi(-400),
+            0.125 * 2f64.powi(-400),
+            0.5 * 2f64.powi(-400),
+            0.875 * 2f64.powi(-400)
+        ),
+    );
+    let unit = orbitri(&["triangulate", pts.to_str().unwrap(), "--box", "1", "1"]);
+    let side = format!("{:e}", 2f64.powi(-400));
+    let tiny = orbitri(&[
+        "triangulate",
+        small.to_str().unwrap(),
+        "--box",
+        &side,
+        &side,
+    ]);
+    assert!(
+        unit.status.success() && tiny.status.success(),
+        "{}",
+        stderr(&tiny)
+    );
+    assert_eq!(unit.stdout, tiny.stdout);
+    // elongated boxes: the documented error, at once (they hung)
+    for b in [["1", "1", "1e-17"].as_slice(), &["1", "1e-10"]] {
+        let mut args = vec!["triangulate", one.to_str().unwrap(), "--box"];
+        args.extend_from_slice(b);
+        let o = orbitri(&args);
+        assert_eq!(o.status.code(), Some(2));
+        assert!(stderr(&o).contains("too elongated"), "{}", stderr(&o));
+    }
+    // Voronoi volumes that doubles cannot hold: a typed error, not inf
+    let o = orbitri(&[
+        "voronoi",
+        one.to_str().unwrap(),
+        "--box",
+        "1e110",
+        "1e110",
+        "1e110",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("outside the range of doubles"),
+        "{}",
+        stderr(&o)
+    );
+}

@@ -166,7 +166,7 @@ impl Triangulation {
         with_tri!(&self.tri, t => {
             let n = t.number_of_input_points();
             let v: Vec<f64> = (0..n)
-                .flat_map(|i| t.points()[t.vertex_of_input(i) as usize])
+                .flat_map(|i| t.point(t.vertex_of_input(i)))
                 .collect();
             array2(py, n, d, v)
         })

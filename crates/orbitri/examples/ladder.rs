@@ -20,7 +20,7 @@ fn run(lattice: &Lattice<2>, kind: Ladder, seed: u64) -> (Vec<usize>, usize) {
     let mut n = 0;
     while !e.is_one_sheeted() {
         let f = [rng.unit(), rng.unit()];
-        let p = lattice.wrap(lattice.cartesian(&f)).0;
+        let p = lattice.wrap(lattice.cartesian(&f)).unwrap().0;
         copies += e.sheets();
         e.insert(p);
         n += 1;

@@ -11,6 +11,14 @@ pub enum Error {
         axis: usize,
         value: f64,
     },
+    #[error(
+        "point {index}: {coordinates} lies too far from the domain (beyond 2^50 periods) to be wrapped into it exactly"
+    )]
+    OutOfReach { index: usize, coordinates: String },
+    #[error(
+        "the domain's volume, about 2^{log2:.0}, is outside the range of doubles: its Voronoi volumes cannot be represented (rescale the coordinates)"
+    )]
+    UnrepresentableVolume { log2: f64 },
     #[error("the input holds no points")]
     EmptyInput,
     #[error("invalid box: {0}")]

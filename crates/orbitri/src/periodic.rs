@@ -101,7 +101,13 @@ pub type PeriodicDelaunay2 = PeriodicDelaunay<2, 3>;
 /// The periodic Delaunay triangulation of a 3D flat torus.
 pub type PeriodicDelaunay3 = PeriodicDelaunay<3, 4>;
 
-fn check_finite<const D: usize>(i: usize, p: &[f64; D]) -> Result<()> {
+/// Input point `i` in the internal frame of the lattice, wrapped into the domain, and whether
+/// wrapping moved it; an error names a non-finite coordinate or a point out of reach.
+fn internal_point<const D: usize>(
+    space: &FlatTorus<D>,
+    i: usize,
+    p: &[f64; D],
+) -> Result<([f64; D], bool)> {
     for (axis, v) in p.iter().enumerate() {
         if !v.is_finite() {
             return Err(Error::NonFiniteCoordinate {
@@ -111,7 +117,13 @@ fn check_finite<const D: usize>(i: usize, p: &[f64; D]) -> Result<()> {
             });
         }
     }
-    Ok(())
+    space
+        .lattice()
+        .wrap_in(*p)
+        .ok_or_else(|| Error::OutOfReach {
+            index: i,
+            coordinates: format!("{p:?}"),
+        })
 }
 
 impl<const D: usize, const N: usize> PeriodicDelaunay<D, N>
@@ -151,8 +163,7 @@ where
         let mut wrapped_pts = Vec::with_capacity(points.len());
         let mut wrapped = 0;
         for (i, p) in points.iter().enumerate() {
-            check_finite(i, p)?;
-            let (w, moved) = space.lattice().wrap(*p);
+            let (w, moved) = internal_point(&space, i, p)?;
             wrapped += moved as usize;
             wrapped_pts.push(w);
         }
@@ -208,7 +219,7 @@ where
             let t = self
                 .space()
                 .lattice()
-                .fractional(&d)
+                .fractional_in(&d)
                 .map(|x| x.round() as i8);
             let exact = self.space().coincide((want, t), (have, [0; D]));
             debug_assert!(exact, "a duplicate is an exact lattice translate");
@@ -285,8 +296,7 @@ where
     /// points given so far. Returns the vertex (point index) it became or coincides with.
     pub fn insert(&mut self, p: [f64; D]) -> Result<Inserted> {
         let i = self.input_point.len();
-        check_finite(i, &p)?;
-        let (w, moved) = self.engine.space().lattice().wrap(p);
+        let (w, moved) = internal_point(self.space(), i, &p)?;
         self.wrapped += moved as usize;
         self.input_point.push(NONE);
         Ok(self.insert_wrapped(i, w))
@@ -353,8 +363,28 @@ where
     }
 
     /// The distinct points (wrapped), indexed by vertex.
-    pub fn points(&self) -> &[[f64; D]] {
-        self.engine.points()
+    pub fn points(&self) -> Vec<[f64; D]> {
+        let lattice = self.space().lattice();
+        self.engine
+            .points()
+            .iter()
+            .map(|&p| lattice.to_user(p))
+            .collect()
+    }
+
+    /// The wrapped position of vertex `v` (a point index).
+    pub fn point(&self, v: u32) -> [f64; D] {
+        self.space()
+            .lattice()
+            .to_user(self.engine.points()[v as usize])
+    }
+
+    /// The position of input point `i`'s image under the lattice translation `offset`:
+    /// `points[i] + offset·M`, in Cartesian coordinates.
+    pub fn position(&self, i: u32, offset: Offset<D>) -> [f64; D] {
+        let p = self.engine.points()[self.vertex_of_input(i as usize) as usize];
+        let space = self.space();
+        space.lattice().to_user(space.position((p, offset)))
     }
 
     /// The vertex of input point `i`.
@@ -468,15 +498,17 @@ where
             .into_iter()
             .map(|s| {
                 let at = |k: usize| {
-                    let p = self.points()[self.vertex_of_input(s.vertices[k] as usize) as usize];
+                    let p =
+                        self.engine.points()[self.vertex_of_input(s.vertices[k] as usize) as usize];
                     self.space().position((p, s.offsets[k]))
                 };
                 let (a, b) = (at(0), at(1));
+                let length = (0..D).map(|c| (b[c] - a[c]).powi(2)).sum::<f64>().sqrt();
                 DelaunayEdge {
                     i: s.vertices[0],
                     j: s.vertices[1],
                     shift: std::array::from_fn(|c| s.offsets[1][c] - s.offsets[0][c]),
-                    length: (0..D).map(|c| (b[c] - a[c]).powi(2)).sum::<f64>().sqrt(),
+                    length: self.space().lattice().measure_to_user(length, 1),
                 }
             })
             .collect()
@@ -518,8 +550,7 @@ where
         if self.number_of_vertices() == 0 {
             return Err(Error::EmptyInput);
         }
-        check_finite(0, &p)?;
-        let (w, _) = self.engine.space().lattice().wrap(p);
+        let (w, _) = internal_point(self.space(), 0, &p)?;
         let (c, o) = self.engine.locate(w);
         Ok((self.view(c), o))
     }

@@ -78,30 +78,6 @@ pub struct Neighbor<const D: usize> {
     pub area: f64,
 }
 
-/// Solves `A x = b` for small `D` by Gaussian elimination with partial pivoting.
-fn solve<const D: usize>(mut a: [[f64; D]; D], mut b: [f64; D]) -> [f64; D] {
-    for col in 0..D {
-        let piv = (col..D)
-            .max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))
-            .unwrap();
-        a.swap(piv, col);
-        b.swap(piv, col);
-        for r in col + 1..D {
-            let f = a[r][col] / a[col][col];
-            for k in col..D {
-                a[r][k] -= f * a[col][k];
-            }
-            b[r] -= f * b[col];
-        }
-    }
-    let mut x = [0.0; D];
-    for r in (0..D).rev() {
-        let s: f64 = (r + 1..D).map(|k| a[r][k] * x[k]).sum();
-        x[r] = (b[r] - s) / a[r][r];
-    }
-    x
-}
-
 fn cross(a: &[f64], b: &[f64]) -> [f64; 3] {
     [
         a[1] * b[2] - a[2] * b[1],
@@ -136,8 +112,9 @@ fn root(parent: &mut [usize], mut x: usize) -> usize {
 }
 
 /// What every Voronoi cell reads from the triangulation, computed once: each stored cell's
-/// circumcenter (Cartesian, in the cell's own frame), the class of each cell under "adjacent
-/// and cospherical" (one Voronoi vertex per class), and the cells around each vertex.
+/// circumcenter (certified, relative to its lifted vertex 0, in the lattice's internal
+/// frame), the class of each cell under "adjacent and cospherical" (one Voronoi vertex per
+/// class), and the cells around each vertex.
 struct Duals<const D: usize> {
     /// Indexed by stored cell id.
     center: Vec<[f64; D]>,
@@ -200,19 +177,7 @@ where
         let slots = ids.iter().max().map_or(0, |&m| m as usize + 1);
         let computed: Vec<[f64; D]> = ids
             .par_iter()
-            .map(|&c| {
-                let base = torus.position(e.lifted(c, 0));
-                let mut a = [[0.0; D]; D];
-                let mut b = [0.0; D];
-                for i in 1..N {
-                    let q = torus.position(e.lifted(c, i));
-                    let d: [f64; D] = std::array::from_fn(|x| q[x] - base[x]);
-                    a[i - 1] = d;
-                    b[i - 1] = 0.5 * dot(&d, &d);
-                }
-                let x = solve(a, b);
-                std::array::from_fn(|k| base[k] + x[k])
-            })
+            .map(|&c| torus.circumcenter(&e.lifted_cell(c)))
             .collect();
         let mut center = vec![[0.0; D]; slots];
         for (k, &c) in ids.iter().enumerate() {
@@ -235,7 +200,7 @@ where
                         .expect("symmetric neighbours");
                     let shift = e.translation(c, x, d);
                     let opposite = (
-                        self.points()[e.point_of(dc.v[y]) as usize],
+                        e.points()[e.point_of(dc.v[y]) as usize],
                         torus.compose(dc.off[y], shift),
                     );
                     torus.cospherical(&lifted, opposite).then_some((c, d))
@@ -282,7 +247,8 @@ where
         let v = e.vertex_of_point(p);
         let star =
             &duals.incident[duals.start[v as usize] as usize..duals.start[v as usize + 1] as usize];
-        let position = self.points()[p as usize];
+        let lattice = torus.lattice();
+        let position = e.points()[p as usize];
         // one Voronoi vertex per class, relative to the point in the frame of its cells
         let mut class_ids: Vec<u32> = Vec::with_capacity(star.len());
         let mut vertices: Vec<[f64; D]> = Vec::with_capacity(star.len());
@@ -293,10 +259,12 @@ where
                 match class_ids.iter().position(|&x| x == class) {
                     Some(i) => i as u32,
                     None => {
-                        let base = torus.position((position, e.cell(c).off[k as usize]));
+                        // the center is relative to the cell's vertex 0
+                        let to_point =
+                            torus.lifted_difference(e.lifted(c, k as usize), e.lifted(c, 0));
                         let z = duals.center[c as usize];
                         class_ids.push(class);
-                        vertices.push(std::array::from_fn(|x| z[x] - base[x]));
+                        vertices.push(std::array::from_fn(|x| z[x] - to_point[x]));
                         vertices.len() as u32 - 1
                     }
                 }
@@ -333,9 +301,8 @@ where
             if ids.len() < D {
                 continue; // the dual of this Delaunay edge has collapsed: no face
             }
-            let other = torus.position(([0.0; D], r));
-            let wp = self.points()[e.point_of(w) as usize];
-            let dir: [f64; D] = std::array::from_fn(|x| wp[x] + other[x] - position[x]);
+            let wp = e.points()[e.point_of(w) as usize];
+            let dir = torus.lifted_difference((wp, r), (position, [0; D]));
             let pts: Vec<&[f64]> = ids.iter().map(|&i| &vertices[i as usize][..]).collect();
             let area = if D == 2 {
                 let d: Vec<f64> = (0..2).map(|x| pts[1][x] - pts[0][x]).collect();
@@ -358,16 +325,18 @@ where
         if D == 2 {
             order_polygon(&mut vertices, &mut faces);
         }
+        // into the user's units: exact scalings by powers of two
+        for f in faces.iter_mut() {
+            f.area = lattice.measure_to_user(f.area, D as i32 - 1);
+        }
+        let around = |x: &[f64; D]| lattice.to_user(std::array::from_fn(|c| position[c] + x[c]));
         VoronoiCell {
             point: self.input_of_vertex(p),
-            position,
-            vertices: vertices
-                .iter()
-                .map(|x| std::array::from_fn(|c| position[c] + x[c]))
-                .collect(),
+            position: lattice.to_user(position),
+            vertices: vertices.iter().map(around).collect(),
             faces,
-            volume,
-            centroid: std::array::from_fn(|c| position[c] + centroid_rel[c]),
+            volume: lattice.measure_to_user(volume, D as i32),
+            centroid: around(&centroid_rel),
         }
     }
 
@@ -434,28 +403,63 @@ fn measure<const D: usize>(vertices: &[[f64; D]], faces: &[VoronoiFace<D>]) -> (
     (vol, acc.map(|x| x / vol))
 }
 
-/// A 2D cell's vertices in counter-clockwise order (by angle around the point, which the
-/// convex cell contains), with the faces' vertex indices renumbered.
+/// A 2D cell's vertices in counter-clockwise order, with the faces' vertex indices
+/// renumbered and each face running counter-clockwise (from `k` to `k + 1`). The order
+/// follows the faces around the cell, so it is exact however close two vertices are; the
+/// turning sense comes from the polygon's signed area.
 fn order_polygon<const D: usize>(vertices: &mut Vec<[f64; D]>, faces: &mut [VoronoiFace<D>]) {
-    let mut order: Vec<usize> = (0..vertices.len()).collect();
-    order.sort_by(|&a, &b| {
-        let (pa, pb) = (&vertices[a], &vertices[b]);
-        pa[1].atan2(pa[0]).total_cmp(&pb[1].atan2(pb[0]))
-    });
-    let mut new_index = vec![0u32; vertices.len()];
-    for (k, &o) in order.iter().enumerate() {
+    let n = vertices.len();
+    let mut ends: Vec<Vec<usize>> = vec![Vec::new(); n];
+    for (f, face) in faces.iter().enumerate() {
+        for &v in &face.vertices {
+            ends[v as usize].push(f);
+        }
+    }
+    assert!(
+        n == faces.len() && ends.iter().all(|e| e.len() == 2),
+        "a Voronoi polygon is a cycle of edges"
+    );
+    // walk the cycle from vertex 0 along face 0
+    let mut cycle = Vec::with_capacity(n);
+    let (mut v, mut f) = (0usize, ends[0][0]);
+    for _ in 0..n {
+        cycle.push(v);
+        let face = &faces[f].vertices;
+        v = if face[0] as usize == v {
+            face[1]
+        } else {
+            face[0]
+        } as usize;
+        f = if ends[v][0] == f {
+            ends[v][1]
+        } else {
+            ends[v][0]
+        };
+    }
+    let area2: f64 = (0..n)
+        .map(|k| {
+            let (a, b) = (&vertices[cycle[k]], &vertices[cycle[(k + 1) % n]]);
+            a[0] * b[1] - a[1] * b[0]
+        })
+        .sum();
+    if area2 < 0.0 {
+        cycle.reverse();
+    }
+    let mut new_index = vec![0u32; n];
+    for (k, &o) in cycle.iter().enumerate() {
         new_index[o] = k as u32;
     }
-    *vertices = order.iter().map(|&o| vertices[o]).collect();
-    for f in faces.iter_mut() {
-        for v in f.vertices.iter_mut() {
-            *v = new_index[*v as usize];
-        }
-        f.vertices.sort_unstable();
-        // counter-clockwise seen from the point: the edge from k to k+1 (or last to first)
-        if f.vertices[0] == 0 && f.vertices[1] as usize == vertices.len() - 1 {
-            f.vertices.reverse();
-        }
+    *vertices = cycle.iter().map(|&o| vertices[o]).collect();
+    for face in faces.iter_mut() {
+        let (a, b) = (
+            new_index[face.vertices[0] as usize],
+            new_index[face.vertices[1] as usize],
+        );
+        face.vertices = if (a + 1) % n as u32 == b {
+            vec![a, b]
+        } else {
+            vec![b, a]
+        };
     }
 }
 

@@ -183,14 +183,8 @@ fn duplicates_and_wrapping_lose_nothing() {
     assert_eq!(first[500], 10);
     assert_eq!(first[501], 20);
     assert_eq!(first[502], 502);
-    assert_eq!(
-        tri.points()[tri.vertex_of_input(502) as usize],
-        [0.0, 0.5, 0.5]
-    );
-    assert_eq!(
-        tri.points()[tri.vertex_of_input(503) as usize],
-        [0.0, 0.25, 0.0]
-    );
+    assert_eq!(tri.point(tri.vertex_of_input(502)), [0.0, 0.5, 0.5]);
+    assert_eq!(tri.point(tri.vertex_of_input(503)), [0.0, 0.25, 0.0]);
     for (i, f) in first.iter().enumerate() {
         assert_eq!(tri.input_of_vertex(tri.vertex_of_input(i)), *f);
     }
@@ -276,10 +270,10 @@ fn access_api() {
         .chain([[1.5, -0.2, 0.7]].iter())
     {
         let (cell, o) = tri.locate(*q).unwrap();
-        let wq = tri.space().lattice().wrap(*q).0;
+        let wq = tri.space().lattice().wrap(*q).unwrap().0;
         let corner = |i: usize| {
             [0, 1, 2].map(|c| {
-                tri.points()[tri.vertex_of_input(cell.vertices[i] as usize) as usize][c]
+                tri.point(tri.vertex_of_input(cell.vertices[i] as usize))[c]
                     + cell.offsets[i][c] as f64
             })
         };

@@ -55,7 +55,7 @@ fn a_duplicate_keeps_the_coordinates_of_its_first_occurrence() {
         canonical_cells(&inc.cells(Copies::Unique)),
         canonical_cells(&bulk.cells(Copies::Unique))
     );
-    let wrapped_c = bulk.space().lattice().wrap(pts[0]).0;
-    assert_eq!(bulk.points()[bulk.vertex_of_input(0) as usize], wrapped_c);
-    assert_eq!(inc.points()[inc.vertex_of_input(0) as usize], wrapped_c);
+    let wrapped_c = bulk.space().lattice().wrap(pts[0]).unwrap().0;
+    assert_eq!(bulk.point(bulk.vertex_of_input(0)), wrapped_c);
+    assert_eq!(inc.point(inc.vertex_of_input(0)), wrapped_c);
 }

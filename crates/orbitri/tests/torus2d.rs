@@ -50,7 +50,7 @@ fn brute_force(tri: &PeriodicDelaunay2) {
     let area_dom = det.abs();
     let sheets = tri.sheets();
     let cells = tri.cells(Copies::Stored);
-    let point = |i: u32| tri.points()[tri.vertex_of_input(i as usize) as usize];
+    let point = |i: u32| tri.point(tri.vertex_of_input(i as usize));
     let mut total = 0.0;
     let mut edges: HashMap<Vec<(u32, [i8; 2])>, usize> = HashMap::new();
     for c in &cells {
@@ -441,12 +441,12 @@ fn access_api_in_2d() {
     let m = tri.space().lattice().vectors();
     for q in [[0.3, 0.2], [0.99, 0.01], [1.2, 0.85]] {
         let (c, o) = tri.locate(q).unwrap();
-        let w = tri.space().lattice().wrap(q).0;
+        let w = tri.space().lattice().wrap(q).unwrap().0;
         let z = lift(w, o, &m);
         let p: Vec<[f64; 2]> = (0..3)
             .map(|i| {
                 lift(
-                    tri.points()[tri.vertex_of_input(c.vertices[i] as usize) as usize],
+                    tri.point(tri.vertex_of_input(c.vertices[i] as usize)),
                     c.offsets[i],
                     &m,
                 )

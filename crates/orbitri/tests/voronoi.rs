@@ -280,9 +280,8 @@ fn cells_equal_clipped_cells_in_3d() {
             let pts = uniform3(&lattice, n, seed);
             let tri = PeriodicDelaunay3::build(FlatTorus::new(lattice.clone()), &pts).unwrap();
             let m = lattice.vectors();
-            let wrapped: Vec<[f64; 3]> = (0..n)
-                .map(|i| tri.points()[tri.vertex_of_input(i) as usize])
-                .collect();
+            let wrapped: Vec<[f64; 3]> =
+                (0..n).map(|i| tri.point(tri.vertex_of_input(i))).collect();
             let cells = tri.voronoi_cells();
             let total: f64 = cells.iter().map(|c| c.volume).sum();
             assert!((total - lattice.volume()).abs() <= 1e-12 * lattice.volume());
@@ -314,9 +313,8 @@ fn cells_equal_clipped_cells_in_2d() {
             let pts = uniform2(&lattice, n, seed);
             let tri = PeriodicDelaunay2::build(FlatTorus::new(lattice.clone()), &pts).unwrap();
             let m = lattice.vectors();
-            let wrapped: Vec<[f64; 2]> = (0..n)
-                .map(|i| tri.points()[tri.vertex_of_input(i) as usize])
-                .collect();
+            let wrapped: Vec<[f64; 2]> =
+                (0..n).map(|i| tri.point(tri.vertex_of_input(i))).collect();
             let cells = tri.voronoi_cells();
             let total: f64 = cells.iter().map(|c| c.volume).sum();
             assert!((total - lattice.volume()).abs() <= 1e-12 * lattice.volume());
@@ -427,8 +425,8 @@ fn volumes_sum_to_the_domain_and_duplicates_share_cells() {
     let edges = tri.delaunay_edges();
     assert_eq!(edges.len(), 20000 + tri.number_of_cells());
     for e in edges.iter().take(500) {
-        let a = tri.points()[tri.vertex_of_input(e.i as usize) as usize];
-        let b = tri.points()[tri.vertex_of_input(e.j as usize) as usize];
+        let a = tri.point(tri.vertex_of_input(e.i as usize));
+        let b = tri.point(tri.vertex_of_input(e.j as usize));
         let l: [f64; 3] = std::array::from_fn(|x| {
             b[x] + (0..3).map(|k| e.shift[k] as f64 * m[k][x]).sum::<f64>() - a[x]
         });
@@ -452,7 +450,7 @@ fn volumes_sum_to_the_domain_and_duplicates_share_cells() {
             .sum();
         for f in &c.faces {
             let m = lattice.vectors();
-            let q = tri.points()[tri.vertex_of_input(f.neighbor as usize) as usize];
+            let q = tri.point(tri.vertex_of_input(f.neighbor as usize));
             let l: [f64; 3] = std::array::from_fn(|x| {
                 q[x] + (0..3).map(|k| f.shift[k] as f64 * m[k][x]).sum::<f64>()
             });

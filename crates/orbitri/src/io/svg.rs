@@ -109,7 +109,7 @@ impl Page<'_> {
 
 /// The Delaunay edges (one per orbit) as segments from the library's edge list.
 fn delaunay_edges(page: &Page, tri: &PeriodicDelaunay2) -> Vec<Shape> {
-    let at = |i: u32| tri.points()[tri.vertex_of_input(i as usize) as usize];
+    let at = |i: u32| tri.point(tri.vertex_of_input(i as usize));
     tri.delaunay_edges()
         .into_iter()
         .map(|e| {
@@ -207,7 +207,7 @@ pub fn write_svg(
         let r = (stroke * 2.0).max(0.8);
         let mut pts = String::new();
         for p in tri.points() {
-            let s = page.shape(vec![*p]);
+            let s = page.shape(vec![p]);
             for t in page.translations(&s) {
                 let (x, y) = page.px([p[0] + t[0], p[1] + t[1]]);
                 let fill = if t == [0.0, 0.0] { "#111" } else { "#777" };

@@ -324,8 +324,7 @@ where
         for k in 0..N {
             let key = (c.vertices[k], c.offsets[k]);
             let id = *index.entry(key).or_insert_with(|| {
-                let p = tri.points()[tri.vertex_of_input(key.0 as usize) as usize];
-                v.points.push(pad(&tri.space().position((p, key.1))));
+                v.points.push(pad(&tri.position(key.0, key.1)));
                 pid.push(key.0 as f64);
                 v.points.len() as u64 - 1
             });

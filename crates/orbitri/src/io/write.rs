@@ -71,8 +71,7 @@ where
     write!(w, "],\"points\":[")?;
     write_list(
         w,
-        (0..tri.number_of_input_points())
-            .map(|i| row(&tri.points()[tri.vertex_of_input(i) as usize])),
+        (0..tri.number_of_input_points()).map(|i| row(&tri.point(tri.vertex_of_input(i)))),
     )?;
     write!(w, "],\"first_occurrence\":[")?;
     write_list(w, tri.first_occurrences().iter().map(|x| x.to_string()))?;

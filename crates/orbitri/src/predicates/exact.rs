@@ -44,6 +44,11 @@ impl Scaled {
         Scaled { emin }
     }
 
+    /// The common scale: the integers are the values divided by `2^exponent`.
+    pub fn exponent(&self) -> i32 {
+        self.emin
+    }
+
     /// `x / 2^emin` as an exact integer.
     pub fn int(&self, x: f64) -> BigInt {
         let (m, e) = decompose(x);
@@ -59,6 +64,32 @@ pub fn sign(x: &BigInt) -> Sign {
         Sign::Positive
     } else {
         Sign::Negative
+    }
+}
+
+/// `num / den · 2^exp` as a double, within two units in the last place (`den ≠ 0`); `±inf`
+/// or `0` beyond the range of doubles.
+pub fn ratio_to_f64(num: &BigInt, den: &BigInt, exp: i32) -> f64 {
+    use num_traits::ToPrimitive;
+    if num.is_zero() {
+        return 0.0;
+    }
+    let negative = num.is_negative() != den.is_negative();
+    let (a, b) = (num.abs(), den.abs());
+    // a quotient of at least 64 bits: its truncation and the rounding to 53 bits are the
+    // only errors
+    let shift = b.bits() as i64 - a.bits() as i64 + 64;
+    let q = if shift >= 0 {
+        (a << shift as usize) / b
+    } else {
+        a / (b << (-shift) as usize)
+    };
+    let m = q.to_f64().unwrap_or(f64::INFINITY);
+    let v = crate::space::ldexp(m, (exp as i64 - shift).clamp(-5000, 5000) as i32);
+    if negative {
+        -v
+    } else {
+        v
     }
 }
 
@@ -86,6 +117,18 @@ mod tests {
         let s = Scaled::new([0.5, 0.25, 3.0]);
         assert_eq!(s.int(0.25), BigInt::from(1));
         assert_eq!(s.int(3.0), BigInt::from(12));
+    }
+
+    #[test]
+    fn ratios_round_to_nearby_doubles() {
+        let third = ratio_to_f64(&BigInt::from(1), &BigInt::from(3), 0);
+        assert!((third - 1.0 / 3.0).abs() <= 2.0 * f64::EPSILON / 3.0);
+        assert_eq!(ratio_to_f64(&BigInt::from(-6), &BigInt::from(4), 3), -12.0);
+        assert_eq!(ratio_to_f64(&BigInt::from(0), &BigInt::from(7), 0), 0.0);
+        let big = BigInt::from(1) << 3000usize;
+        let x = ratio_to_f64(&BigInt::from(5), &big, 2990);
+        assert_eq!(x, 5.0 / 1024.0);
+        assert_eq!(ratio_to_f64(&big, &BigInt::from(1), 0), f64::INFINITY);
     }
 
     #[test]

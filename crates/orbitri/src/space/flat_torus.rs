@@ -89,14 +89,20 @@ impl<const D: usize> FlatTorus<D> {
         &self.lattice
     }
 
-    /// Cartesian position of a lifted point (rounded).
-    pub fn position(&self, (p, o): L<D>) -> [f64; D] {
+    /// Cartesian position of a lifted point (rounded), in the lattice's internal frame.
+    pub(crate) fn position(&self, (p, o): L<D>) -> [f64; D] {
         let (s, _) = self.lattice.rows.apply(widen(o));
         std::array::from_fn(|c| p[c] + s[c])
     }
 
     /// The lifted points as exact integers, all scaled by one power of two.
     pub(super) fn exact_lift(&self, pts: &[L<D>]) -> Vec<[BigInt; D]> {
+        self.exact_lift_scaled(pts).0
+    }
+
+    /// [`Self::exact_lift`] and the exponent `e` of the scale: the integers are the
+    /// coordinates divided by `2^e`.
+    fn exact_lift_scaled(&self, pts: &[L<D>]) -> (Vec<[BigInt; D]>, i32) {
         let m = &self.lattice.rows.m;
         let scale = Scaled::new(
             pts.iter()
@@ -104,7 +110,8 @@ impl<const D: usize> FlatTorus<D> {
                 .chain(m.iter().flatten().copied()),
         );
         let mi: Vec<[BigInt; D]> = m.iter().map(|r| r.map(|x| scale.int(x))).collect();
-        pts.iter()
+        let lifted = pts
+            .iter()
             .map(|(p, o)| {
                 std::array::from_fn(|c| {
                     let mut v = scale.int(p[c]);
@@ -116,7 +123,39 @@ impl<const D: usize> FlatTorus<D> {
                     v
                 })
             })
-            .collect()
+            .collect();
+        (lifted, scale.exponent())
+    }
+
+    /// The lifted difference `a − b` in Cartesian coordinates, to within `6u` of its
+    /// magnitude bound (not through rounded positions).
+    pub(crate) fn lifted_difference(&self, a: L<D>, b: L<D>) -> [f64; D] {
+        lifted_diff(&self.lattice.rows, &a.0, widen(a.1), &b.0, widen(b.1)).0
+    }
+
+    /// The circumcenter of a lifted simplex relative to its vertex 0, certified (see
+    /// [`OrbitSpace::circumcenter`](super::OrbitSpace::circumcenter)). `polynomials` gives
+    /// the numerator and the determinant of `x = numerator / (2·det)` from the edge vectors
+    /// (rows, from vertex 0); `exact` the same on exact integers.
+    pub(super) fn certified_center<const N: usize>(
+        &self,
+        s: &[L<D>; N],
+        polynomials: CenterPolynomials<D>,
+        exact: impl Fn(&[[BigInt; D]; D]) -> ([BigInt; D], BigInt),
+    ) -> [f64; D] {
+        let (d, b) = self.rows(std::array::from_fn(|i| &s[i + 1]), &s[0]);
+        if let Some(x) = filtered_center(&d, &b, polynomials) {
+            return x;
+        }
+        let (l, e) = self.exact_lift_scaled(s);
+        let rows: [[BigInt; D]; D] =
+            std::array::from_fn(|i| std::array::from_fn(|c| &l[i + 1][c] - &l[0][c]));
+        let (num, det) = exact(&rows);
+        if det == BigInt::from(0) {
+            return [f64::INFINITY; D];
+        }
+        let den = det * 2;
+        num.map(|n| exact::ratio_to_f64(&n, &den, e))
     }
 
     /// The lifted differences `s[i] − base` with their error bounds (see
@@ -265,14 +304,14 @@ impl<const D: usize> FlatTorus<D> {
         out: &mut Vec<(u32, [i8; D])>,
     ) {
         let zc = self.position(z);
-        let fz = self.lattice.fractional(&zc);
-        let r = radius * (1.0 + 1e-9) + 1e-12 * self.lattice.systole();
+        let fz = self.lattice.fractional_in(&zc);
+        let r = radius * (1.0 + 1e-9) + 1e-12 * self.lattice.systole_in();
         // a Cartesian move of length r changes fractional coordinate c by at most r·|column c of M⁻¹|
         let span: [f64; D] = std::array::from_fn(|c| {
             let col: f64 = (0..D)
                 .map(|k| {
                     self.lattice
-                        .fractional(&std::array::from_fn(|j| if j == k { 1.0 } else { 0.0 }))[c]
+                        .fractional_in(&std::array::from_fn(|j| if j == k { 1.0 } else { 0.0 }))[c]
                         .powi(2)
                 })
                 .sum();
@@ -300,7 +339,8 @@ impl<const D: usize> FlatTorus<D> {
         } else {
             // largest empty ball of one point: diameter ≤ √(Σ|b_i|²)
             self.lattice
-                .vectors()
+                .rows
+                .m
                 .iter()
                 .map(|r| r.iter().map(|x| x * x).sum::<f64>())
                 .sum::<f64>()
@@ -310,10 +350,67 @@ impl<const D: usize> FlatTorus<D> {
 
     /// Grid cell of a point for a space-filling curve: `bits` bits per lattice coordinate.
     pub(super) fn grid_cell(&self, p: &[f64; D], bits: u32) -> [u32; D] {
-        let f = self.lattice.fractional(p);
+        let f = self.lattice.fractional_in(p);
         let scale = (1u64 << bits) as f64;
         f.map(|v| ((v.clamp(0.0, 1.0) * scale) as u64).min((1 << bits) - 1) as u32)
     }
+}
+
+/// The circumcenter polynomials of a simplex's edge vectors `d` (rows, from vertex 0): the
+/// circumcenter is `numerator / (2·det)`. `minus` is subtraction; evaluated with addition
+/// on magnitudes, the same expression bounds every monomial (for the error bound).
+pub(super) type CenterPolynomials<const D: usize> =
+    fn(&[[f64; D]; D], fn(f64, f64) -> f64) -> ([f64; D], f64);
+
+/// A circumcenter accepted when its certified error is below this fraction of its
+/// magnitude and of the simplex's extent.
+const CENTER_TOLERANCE: f64 = 1.0 / (1u64 << 44) as f64;
+
+/// The floating-point circumcenter when its error bound allows, else `None`.
+///
+/// Bound: each entry of `d` is within `e_i = 6u·b_i` of the exact lifted difference. For a
+/// polynomial `P` and `Q` its expression evaluated with `+` on magnitudes, `|P(x) − P(x̃)| ≤
+/// Q(|x̃| + e) − Q(|x̃|)` (every monomial holding an error term), and the rounding of `P(x̃)`
+/// is at most `γ_k·Q(|x̃|)`, `k ≤ 8` roundings deep; computing the two `Q` values rounds
+/// at most as much again. Then `x = N/D` with `D = 2·det` is off by at most
+/// `u|x̃| + (e_N + |x̃|·e_D)/(|D̃| − e_D)` per coordinate.
+fn filtered_center<const D: usize>(
+    d: &[[f64; D]; D],
+    b: &[f64; D],
+    polynomials: CenterPolynomials<D>,
+) -> Option<[f64; D]> {
+    const U: f64 = f64::EPSILON / 2.0;
+    // rows within [2^-200, 2^200]: no product of four entries underflows or overflows
+    let (tiny, huge) = (2f64.powi(-200), 2f64.powi(200));
+    if !b.iter().all(|&x| (tiny..=huge).contains(&x)) {
+        return None;
+    }
+    let gamma = 9.0 * U;
+    let minus = |x: f64, y: f64| x - y;
+    let plus = |x: f64, y: f64| x + y;
+    let (num, det) = polynomials(d, minus);
+    let magnitude = d.map(|r| r.map(f64::abs));
+    let widened: [[f64; D]; D] =
+        std::array::from_fn(|i| magnitude[i].map(|x| x + 6.0 * U * b[i] * (1.0 + 2.0 * U)));
+    let (num0, det0) = polynomials(&magnitude, plus);
+    let (num1, det1) = polynomials(&widened, plus);
+    let err = |q0: f64, q1: f64| ((q1 - q0) + 3.0 * gamma * q1) * (1.0 + 4.0 * U);
+    let den = 2.0 * det;
+    let err_den = 2.0 * err(det0, det1);
+    if !den.is_finite() || !err_den.is_finite() || den.abs() <= 2.0 * err_den {
+        return None;
+    }
+    let extent = b.iter().fold(0.0f64, |a, &x| a.max(x));
+    let mut x = [0.0; D];
+    for k in 0..D {
+        x[k] = num[k] / den;
+        let q = x[k].abs() * (1.0 + U);
+        let bound = 2.0 * U * q + (err(num0[k], num1[k]) + q * err_den) / (den.abs() - err_den);
+        if bound.is_nan() || bound > CENTER_TOLERANCE * x[k].abs().max(extent) {
+            return None;
+        }
+    }
+    Some(x)
 }
 
 /// The orbit-space methods that do not depend on the dimension, for an `impl OrbitSpace<N>

@@ -39,6 +39,19 @@ impl FlatTorus<2> {
     }
 }
 
+/// The circumcenter `(l_0 d_1⊥ − l_1 d_0⊥) / (2·det)` of the edge vectors `d` (Cramer's rule).
+fn center_polynomials(d: &[[f64; 2]; 2], minus: fn(f64, f64) -> f64) -> ([f64; 2], f64) {
+    let l = d.map(|r| r[0] * r[0] + r[1] * r[1]);
+    let det = minus(d[0][0] * d[1][1], d[0][1] * d[1][0]);
+    (
+        [
+            minus(l[0] * d[1][1], l[1] * d[0][1]),
+            minus(l[1] * d[0][0], l[0] * d[1][0]),
+        ],
+        det,
+    )
+}
+
 impl OrbitSpace<3> for FlatTorus<2> {
     type Point = [f64; 2];
     type Offset = [i8; 2];
@@ -60,20 +73,20 @@ impl OrbitSpace<3> for FlatTorus<2> {
     }
 
     fn circumradius2(&self, s: &[L2; 3]) -> f64 {
-        let (d, _) = self.rows([&s[1], &s[2]], &s[0]);
-        let (l1, l2) = (
-            d[0][0] * d[0][0] + d[0][1] * d[0][1],
-            d[1][0] * d[1][0] + d[1][1] * d[1][1],
-        );
-        let det = 2.0 * (d[0][0] * d[1][1] - d[0][1] * d[1][0]);
-        let ux = (d[1][1] * l1 - d[0][1] * l2) / det;
-        let uy = (d[0][0] * l2 - d[1][0] * l1) / det;
-        let r2 = ux * ux + uy * uy;
-        if r2.is_finite() {
-            r2
-        } else {
-            f64::INFINITY
-        }
+        let x = self.circumcenter(s);
+        x[0] * x[0] + x[1] * x[1]
+    }
+
+    fn circumcenter(&self, s: &[L2; 3]) -> [f64; 2] {
+        self.certified_center(s, center_polynomials, |d| {
+            let l = d.each_ref().map(|r| &r[0] * &r[0] + &r[1] * &r[1]);
+            let det = &d[0][0] * &d[1][1] - &d[0][1] * &d[1][0];
+            let num = [
+                &l[0] * &d[1][1] - &l[1] * &d[0][1],
+                &l[1] * &d[0][0] - &l[0] * &d[1][0],
+            ];
+            (num, det)
+        })
     }
 
     fn spatial_key(&self, p: &[f64; 2]) -> u64 {

@@ -45,6 +45,28 @@ impl FlatTorus<3> {
     }
 }
 
+/// The circumcenter `Σ l_i (d_j × d_k) / (2·det)` of the edge vectors `d` (Cramer's rule).
+fn center_polynomials(d: &[[f64; 3]; 3], minus: fn(f64, f64) -> f64) -> ([f64; 3], f64) {
+    let l = d.map(|r| r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
+    let cross = |a: &[f64; 3], b: &[f64; 3]| {
+        [
+            minus(a[1] * b[2], a[2] * b[1]),
+            minus(a[2] * b[0], a[0] * b[2]),
+            minus(a[0] * b[1], a[1] * b[0]),
+        ]
+    };
+    let (c12, c20, c01) = (
+        cross(&d[1], &d[2]),
+        cross(&d[2], &d[0]),
+        cross(&d[0], &d[1]),
+    );
+    let det = d[0][0] * c12[0] + d[0][1] * c12[1] + d[0][2] * c12[2];
+    (
+        std::array::from_fn(|k| l[0] * c12[k] + l[1] * c20[k] + l[2] * c01[k]),
+        det,
+    )
+}
+
 impl OrbitSpace<4> for FlatTorus<3> {
     type Point = [f64; 3];
     type Offset = [i8; 3];
@@ -66,33 +88,31 @@ impl OrbitSpace<4> for FlatTorus<3> {
     }
 
     fn circumradius2(&self, s: &[L3; 4]) -> f64 {
-        let (d, _) = self.rows([&s[1], &s[2], &s[3]], &s[0]);
-        let l: [f64; 3] =
-            std::array::from_fn(|i| d[i][0] * d[i][0] + d[i][1] * d[i][1] + d[i][2] * d[i][2]);
-        let cross = |a: &[f64; 3], b: &[f64; 3]| {
-            [
-                a[1] * b[2] - a[2] * b[1],
-                a[2] * b[0] - a[0] * b[2],
-                a[0] * b[1] - a[1] * b[0],
-            ]
-        };
-        let (c12, c20, c01) = (
-            cross(&d[1], &d[2]),
-            cross(&d[2], &d[0]),
-            cross(&d[0], &d[1]),
-        );
-        let det = d[0][0] * c12[0] + d[0][1] * c12[1] + d[0][2] * c12[2];
-        if det == 0.0 {
-            return f64::INFINITY;
-        }
-        let c: [f64; 3] =
-            std::array::from_fn(|k| (l[0] * c12[k] + l[1] * c20[k] + l[2] * c01[k]) / (2.0 * det));
-        let r2 = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
-        if r2.is_nan() {
-            f64::INFINITY
-        } else {
-            r2
-        }
+        let x = self.circumcenter(s);
+        x[0] * x[0] + x[1] * x[1] + x[2] * x[2]
+    }
+
+    fn circumcenter(&self, s: &[L3; 4]) -> [f64; 3] {
+        self.certified_center(s, center_polynomials, |d| {
+            let l = d
+                .each_ref()
+                .map(|r| &r[0] * &r[0] + &r[1] * &r[1] + &r[2] * &r[2]);
+            let cross = |a: &[BigInt; 3], b: &[BigInt; 3]| -> [BigInt; 3] {
+                [
+                    &a[1] * &b[2] - &a[2] * &b[1],
+                    &a[2] * &b[0] - &a[0] * &b[2],
+                    &a[0] * &b[1] - &a[1] * &b[0],
+                ]
+            };
+            let (c12, c20, c01) = (
+                cross(&d[1], &d[2]),
+                cross(&d[2], &d[0]),
+                cross(&d[0], &d[1]),
+            );
+            let det = &d[0][0] * &c12[0] + &d[0][1] * &c12[1] + &d[0][2] * &c12[2];
+            let num = std::array::from_fn(|k| &l[0] * &c12[k] + &l[1] * &c20[k] + &l[2] * &c01[k]);
+            (num, det)
+        })
     }
 
     fn spatial_key(&self, p: &[f64; 3]) -> u64 {

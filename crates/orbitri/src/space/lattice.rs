@@ -33,6 +33,7 @@ pub enum Ladder {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Level<const D: usize> {
     pub sub: Sublattice<D>,
+    /// In the lattice's internal frame (user units: times [`Lattice::unit`]).
     pub systole: f64,
 }
 
@@ -47,12 +48,72 @@ pub const MAX_COPIES: i32 = 24;
 
 /// A lattice given by `D` linearly independent row vectors; the domain is
 /// `{ f·M : f ∈ [0,1)^D }`.
+///
+/// **The internal frame.** Everything the triangulation computes happens in a frame where
+/// lengths are measured in `unit`, the power of two that brings the largest entry of `M` into
+/// `[1, 2)`. Scaling by a power of two is exact, so a triangulation does not depend on the
+/// scale of its input at all: the box `1e-300` and the box `1e300` give the same cells, and
+/// the floating-point filters, circumradii and covering tests never underflow or overflow.
+/// A coordinate smaller than `2^-1022·unit` becomes subnormal in that frame and is rounded to
+/// a multiple of `2^-1074·unit` (the finest resolution the doubles allow at that scale); the
+/// methods without the `_in` suffix take and return the user's units.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Lattice<const D: usize> {
+    /// The rows in the internal frame.
     pub(crate) rows: Rows<D>,
+    /// One internal length unit in user units (a power of two).
+    unit: f64,
+    exponent: i32,
     inv: [[f64; D]; D],
     systole: f64,
     volume: f64,
+}
+
+/// `x·2^k`, correctly rounded for every `k`: `±inf` above the doubles' range, `±0` or a
+/// subnormal below it.
+pub(crate) fn ldexp(x: f64, k: i32) -> f64 {
+    if x == 0.0 || !x.is_finite() {
+        return x;
+    }
+    // x into [1, 2), exactly (a subnormal only grows, a normal stays normal)
+    let e = exponent_of(x);
+    let x = if -e > 1023 {
+        x * pow2(537) * pow2(-e - 537)
+    } else {
+        x * pow2(-e)
+    };
+    let k = k.saturating_add(e);
+    if k > 1023 {
+        x * f64::INFINITY
+    } else if k >= -1022 {
+        x * pow2(k)
+    } else if k < -1080 {
+        x * 0.0
+    } else {
+        // the first factor keeps it normal (exact), the second rounds once
+        x * pow2(-537) * pow2(k + 537)
+    }
+}
+
+/// `2^k` for `−1074 ≤ k ≤ 1023`.
+fn pow2(k: i32) -> f64 {
+    if k >= -1022 {
+        f64::from_bits(((k + 1023) as u64) << 52)
+    } else {
+        f64::from_bits(1u64 << (k + 1074))
+    }
+}
+
+/// `⌊log₂|x|⌋` of a finite non-zero double (subnormals included).
+fn exponent_of(x: f64) -> i32 {
+    let bits = x.abs().to_bits();
+    let biased = (bits >> 52) as i32;
+    if biased > 0 {
+        biased - 1023
+    } else {
+        // subnormal: the leading bit of the fraction
+        -1074 + (63 - bits.leading_zeros() as i32)
+    }
 }
 
 impl<const D: usize> Lattice<D> {
@@ -97,11 +158,22 @@ impl<const D: usize> Lattice<D> {
         Self::build(rows, diagonal)
     }
 
-    fn build(m: [[f64; D]; D], diagonal: bool) -> Result<Self> {
+    fn build(user: [[f64; D]; D], diagonal: bool) -> Result<Self> {
+        let largest = user.iter().flatten().fold(0.0f64, |a, x| a.max(x.abs()));
+        let exponent = exponent_of(largest);
+        let m = user.map(|r| r.map(|x| ldexp(x, -exponent)));
+        if let Some(i) = (0..D).find(|&i| norm(&m[i]) < 1e-200) {
+            return Err(Error::InvalidBox(format!(
+                "too elongated: lattice vector {i} is {} times shorter than the longest entry",
+                largest / norm(&user[i])
+            )));
+        }
         let (det, inv) = invert(&m);
         let norms: f64 = m.iter().map(norm).product();
         if det == 0.0 || !det.is_finite() || det.abs() <= 1e-12 * norms {
-            return Err(Error::SingularLattice { det: det.abs() });
+            return Err(Error::SingularLattice {
+                det: ldexp(det.abs(), exponent * D as i32),
+            });
         }
         let defect = norms / det.abs();
         if defect > MAX_DEFECT {
@@ -114,38 +186,167 @@ impl<const D: usize> Lattice<D> {
         let systole = shortest_vector(&rows, &diagonal_basis([1; D]));
         let lattice = Lattice {
             rows,
+            unit: pow2(exponent),
+            exponent,
             inv,
             systole,
             volume: det.abs(),
         };
-        let h = lattice.covering();
-        if let Some(i) = (0..D).find(|&i| h[i] > MAX_COPIES) {
-            return Err(Error::InvalidBox(format!(
-                "too elongated: the covering space would need {} copies along vector {i} (at most {MAX_COPIES}); keep each edge above 1/{} of the box diagonal",
-                h[i],
-                MAX_COPIES / 2
-            )));
-        }
+        lattice.covering_or_error()?;
         Ok(lattice)
+    }
+
+    /// The covering of [`Self::covering`], or the "too elongated" error when it would need
+    /// more than [`MAX_COPIES`] copies along some vector.
+    fn covering_or_error(&self) -> Result<[i32; D]> {
+        let too_elongated = |i: usize, copies: String| {
+            Error::InvalidBox(format!(
+                "too elongated: the covering space would need {copies} copies along vector {i} (at most {MAX_COPIES}); keep each edge above 1/{} of the box diagonal",
+                MAX_COPIES / 2
+            ))
+        };
+        // the sublattice holds h_i·b_i, so h_i > need/|b_i|: decided before any search
+        let need = self.one_point_need();
+        if let Some(i) = (0..D).find(|&i| need / norm(&self.rows.m[i]) >= MAX_COPIES as f64) {
+            let at_least = (need / norm(&self.rows.m[i])).floor();
+            return Err(too_elongated(i, format!("more than {at_least:.3e}")));
+        }
+        let h = self.covering();
+        match (0..D).find(|&i| h[i] > MAX_COPIES) {
+            Some(i) => Err(too_elongated(i, h[i].to_string())),
+            None => Ok(h),
+        }
+    }
+
+    /// One internal length unit in user units: the power of two by which the user's
+    /// coordinates are divided (see the type's documentation).
+    pub fn unit(&self) -> f64 {
+        self.unit
+    }
+
+    /// A user point in the internal frame (exact unless it becomes subnormal there).
+    pub(crate) fn to_internal(&self, x: [f64; D]) -> [f64; D] {
+        x.map(|v| ldexp(v, -self.exponent))
+    }
+
+    /// An internal point in user units (exact).
+    pub(crate) fn to_user(&self, x: [f64; D]) -> [f64; D] {
+        x.map(|v| ldexp(v, self.exponent))
+    }
+
+    /// An internal length, area (`power` 2) or volume (`power` 3) in user units: exact, or
+    /// `inf`/`0` where the doubles cannot hold it.
+    pub(crate) fn measure_to_user(&self, x: f64, power: i32) -> f64 {
+        ldexp(x, (self.exponent * power).clamp(-2100, 2100))
     }
 
     /// The lattice vectors (rows).
     pub fn vectors(&self) -> [[f64; D]; D] {
-        self.rows.m
+        self.rows.m.map(|r| self.to_user(r))
     }
 
     /// Length of the shortest non-zero lattice vector (δ).
     pub fn systole(&self) -> f64 {
-        self.systole
+        self.measure_to_user(self.systole, 1)
     }
 
-    /// Volume (area in 2D) of the domain.
+    /// Volume (area in 2D) of the domain; `inf` or `0` when the doubles cannot hold it (a
+    /// 3D box of side beyond about `5.6e102` or below `2.8e-103`).
     pub fn volume(&self) -> f64 {
-        self.volume
+        self.measure_to_user(self.volume, D as i32)
+    }
+
+    /// Ok when the domain volume is a normal double, so that Voronoi volumes in the user's
+    /// units can be represented; the typed error otherwise.
+    pub fn check_volume_representable(&self) -> Result<()> {
+        if self.volume().is_normal() {
+            Ok(())
+        } else {
+            Err(Error::UnrepresentableVolume {
+                log2: self.volume.log2() + (self.exponent * D as i32) as f64,
+            })
+        }
     }
 
     /// Fractional (lattice) coordinates `x·M⁻¹`, approximately.
     pub fn fractional(&self, x: &[f64; D]) -> [f64; D] {
+        self.fractional_in(&self.to_internal(*x))
+    }
+
+    /// Cartesian coordinates of fractional coordinates.
+    pub fn cartesian(&self, f: &[f64; D]) -> [f64; D] {
+        self.to_user(self.cartesian_in(f))
+    }
+
+    /// Wraps a point into the half-open domain. Returns the wrapped point and whether it
+    /// moved, or `None` for a triclinic lattice when the point is so far away (beyond about
+    /// `2^50` periods) that no exact wrap exists in floating point. For a box, the result lies
+    /// exactly in `[0, L)` per axis (a point on the upper face goes to 0); for a triclinic
+    /// lattice the domain test uses rounded fractional coordinates.
+    pub fn wrap(&self, x: [f64; D]) -> Option<([f64; D], bool)> {
+        self.wrap_in(x).map(|(y, moved)| (self.to_user(y), moved))
+    }
+
+    /// [`Self::wrap`] into the internal frame.
+    pub(crate) fn wrap_in(&self, x: [f64; D]) -> Option<([f64; D], bool)> {
+        // `-0.0 + 0.0 = +0.0`: one zero, so that coordinate comparisons agree with geometry
+        let x = x.map(|v| v + 0.0);
+        if self.rows.diagonal {
+            let mut y = x;
+            let mut moved = false;
+            for (c, yc) in y.iter_mut().enumerate() {
+                let l = ldexp(self.rows.m[c][c], self.exponent);
+                if *yc >= 0.0 && *yc < l {
+                    continue;
+                }
+                moved = true;
+                // the remainder is exact at every magnitude (IEEE fmod); only adding the
+                // period to a negative one rounds
+                let mut v = *yc % l;
+                if v < 0.0 {
+                    v += l;
+                    if v >= l {
+                        v = 0.0;
+                    }
+                }
+                *yc = v + 0.0;
+            }
+            return Some((self.to_internal(y), moved));
+        }
+        let mut y = self.to_internal(x);
+        if y.iter().any(|v| !v.is_finite()) {
+            return None;
+        }
+        let mut moved = false;
+        for _ in 0..4 {
+            let f = self.fractional_in(&y);
+            if f.iter().all(|v| (0.0..1.0).contains(v)) {
+                return Some((y, moved));
+            }
+            if f.iter().any(|v| v.abs() > 1e15) {
+                return None;
+            }
+            moved = true;
+            let mut shift = [0.0; D];
+            for c in 0..D {
+                let k = f[c].floor();
+                // A coordinate that floors to 0 but rounds to 1 sits on the upper face.
+                shift[c] = if k == 0.0 && f[c] >= 1.0 { 1.0 } else { k };
+            }
+            let s = self.cartesian_in(&shift);
+            for c in 0..D {
+                y[c] -= s[c];
+            }
+        }
+        // rounding may leave a point a hair outside: close enough for the engine's offsets
+        let f = self.fractional_in(&y);
+        f.iter()
+            .all(|v| (-1e-9..1.0 + 1e-9).contains(v))
+            .then_some((y, moved))
+    }
+
+    /// Fractional coordinates of an internal point.
+    pub(crate) fn fractional_in(&self, x: &[f64; D]) -> [f64; D] {
         let mut f = [0.0; D];
         for (c, fc) in f.iter_mut().enumerate() {
             for k in 0..D {
@@ -155,8 +356,8 @@ impl<const D: usize> Lattice<D> {
         f
     }
 
-    /// Cartesian coordinates of fractional coordinates.
-    pub fn cartesian(&self, f: &[f64; D]) -> [f64; D] {
+    /// The internal point of fractional coordinates.
+    pub(crate) fn cartesian_in(&self, f: &[f64; D]) -> [f64; D] {
         let mut x = [0.0; D];
         for (k, fk) in f.iter().enumerate() {
             for (c, xc) in x.iter_mut().enumerate() {
@@ -166,55 +367,9 @@ impl<const D: usize> Lattice<D> {
         x
     }
 
-    /// Wraps a point into the half-open domain. Returns the wrapped point and whether it moved.
-    /// For a box, the result lies exactly in `[0, L)` per axis (a point on the upper face goes
-    /// to 0); for a triclinic lattice the domain test uses rounded fractional coordinates.
-    pub fn wrap(&self, x: [f64; D]) -> ([f64; D], bool) {
-        // `-0.0 + 0.0 = +0.0`: one zero, so that coordinate comparisons agree with geometry
-        let x = x.map(|v| v + 0.0);
-        if self.rows.diagonal {
-            let mut y = x;
-            let mut moved = false;
-            for (c, yc) in y.iter_mut().enumerate() {
-                let l = self.rows.m[c][c];
-                if *yc >= 0.0 && *yc < l {
-                    continue;
-                }
-                moved = true;
-                let mut v = *yc - (*yc / l).floor() * l;
-                if v >= l {
-                    v -= l;
-                }
-                if v < 0.0 {
-                    v += l;
-                    if v >= l {
-                        v = 0.0;
-                    }
-                }
-                *yc = v;
-            }
-            return (y, moved);
-        }
-        let mut y = x;
-        let mut moved = false;
-        for _ in 0..4 {
-            let f = self.fractional(&y);
-            if f.iter().all(|v| (0.0..1.0).contains(v)) {
-                break;
-            }
-            moved = true;
-            let mut shift = [0.0; D];
-            for c in 0..D {
-                let k = f[c].floor();
-                // A coordinate that floors to 0 but rounds to 1 sits on the upper face.
-                shift[c] = if k == 0.0 && f[c] >= 1.0 { 1.0 } else { k };
-            }
-            let s = self.cartesian(&shift);
-            for c in 0..D {
-                y[c] -= s[c];
-            }
-        }
-        (y, moved)
+    /// The systole in the internal frame.
+    pub(crate) fn systole_in(&self) -> f64 {
+        self.systole
     }
 
     /// The covering used for tiny point sets: `h_i` copies along lattice vector `i` such that
@@ -233,6 +388,10 @@ impl<const D: usize> Lattice<D> {
         let mut h: [i32; D] =
             std::array::from_fn(|i| ((big / norm(&self.rows.m[i])).floor() as i32).max(1));
         while shortest_vector(&self.rows, &diagonal_basis(h)) <= big {
+            if h.iter().any(|&x| x > MAX_COPIES) {
+                // no acceptable covering: `covering_or_error` reports it
+                break;
+            }
             let i = (0..D).min_by(|&a, &b| {
                 let la = h[a] as f64 * norm(&self.rows.m[a]);
                 let lb = h[b] as f64 * norm(&self.rows.m[b]);
@@ -340,7 +499,11 @@ impl<const D: usize> Lattice<D> {
                 let jitter = 0.02 * (2.0 * rng.unit() - 1.0);
                 f[i] = (g as f64 + 0.5 + jitter) / k[i] as f64;
             }
-            out.push(self.wrap(self.cartesian(&f)).0);
+            out.push(
+                self.wrap_in(self.cartesian(&f))
+                    .expect("a fractional point wraps")
+                    .0,
+            );
         }
         out
     }
@@ -546,13 +709,18 @@ mod tests {
     #[test]
     fn wrapping_lands_in_the_half_open_domain() {
         let b = Lattice::cuboid([1.0, 2.0, 1.0]).unwrap();
-        assert_eq!(b.wrap([1.0, 2.0, -1e-20]), ([0.0, 0.0, 0.0], true));
-        assert_eq!(b.wrap([0.5, 0.5, 0.5]), ([0.5, 0.5, 0.5], false));
-        assert!(b.wrap([-0.0, 0.5, 0.5]).0[0].is_sign_positive());
-        assert_eq!(b.wrap([-0.25, 4.5, 3.75]).0, [0.75, 0.5, 0.75]);
+        assert_eq!(b.wrap([1.0, 2.0, -1e-20]), Some(([0.0, 0.0, 0.0], true)));
+        assert_eq!(b.wrap([0.5, 0.5, 0.5]), Some(([0.5, 0.5, 0.5], false)));
+        assert!(b.wrap([-0.0, 0.5, 0.5]).unwrap().0[0].is_sign_positive());
+        assert_eq!(b.wrap([-0.25, 4.5, 3.75]).unwrap().0, [0.75, 0.5, 0.75]);
+        // a box wraps exactly at any distance (IEEE remainder)
+        assert_eq!(b.wrap([1e300 + 0.0, 0.5, 0.5]).unwrap().0[0], 1e300 % 1.0);
+        assert_eq!(b.wrap([-1e300, 0.5, 0.5]).unwrap().0[0], 0.0);
         let t = Lattice::new([[1.0, 0.0, 0.0], [0.5, 1.0, 0.0], [0.3, 0.2, 0.9]]).unwrap();
+        // a triclinic lattice cannot wrap a point 1e300 periods away exactly
+        assert_eq!(t.wrap([1e300, 0.0, 0.0]), None);
         for x in [[2.3, -1.7, 5.1], [-0.1, -0.1, -0.1], [1.8, 1.2, 0.95]] {
-            let (y, _) = t.wrap(x);
+            let (y, _) = t.wrap(x).unwrap();
             let f = t.fractional(&y);
             assert!(f.iter().all(|v| (-1e-12..1.0).contains(v)), "{f:?}");
             // y − x is a lattice vector
@@ -604,7 +772,7 @@ mod tests {
                     }
                 }
                 assert!(
-                    (best - w[0].systole).abs() < 1e-12,
+                    (best - w[0].systole * l.unit()).abs() < 1e-12,
                     "{best} {}",
                     w[0].systole
                 );
@@ -618,6 +786,60 @@ mod tests {
                 [27, 1]
             );
         }
+    }
+
+    #[test]
+    fn ldexp_is_exact_scaling_with_one_rounding() {
+        for x in [1.0, -3.5, 0.1, 1e-310, 5e-324, f64::MAX, 1.5e300] {
+            for k in [-2200, -1100, -1074, -600, -1, 0, 1, 600, 1100, 2200] {
+                let want = if k >= 0 {
+                    (0..k).fold(x, |a, _| a * 2.0)
+                } else {
+                    // exact halving down to where it would round: compare with powi on
+                    // representable cases only
+                    let y = (0..-k).fold(x, |a, _| a / 2.0);
+                    if y != 0.0 && y.abs() < f64::MIN_POSITIVE {
+                        continue;
+                    }
+                    y
+                };
+                assert_eq!(ldexp(x, k), want, "{x} {k}");
+            }
+        }
+        // one rounding into the subnormals: 1.75·2^-1074 rounds to 2^-1073
+        assert_eq!(ldexp(1.75, -1074), 2.0 * 5e-324);
+        assert_eq!(ldexp(1.0, -1075), 0.0);
+        assert_eq!(ldexp(1.5, -1075), 5e-324);
+        assert_eq!(exponent_of(5e-324), -1074);
+        assert_eq!(exponent_of(1.0), 0);
+        assert_eq!(exponent_of(-3.0), 1);
+    }
+
+    #[test]
+    fn the_internal_frame_is_a_power_of_two() {
+        for scale in [1e-300, 1e-120, 1.0, 3.0, 1e110, 1e300] {
+            let l = Lattice::cuboid([scale, scale, 2.0 * scale]).unwrap();
+            let m = l.rows.m;
+            assert!((1.0..2.0).contains(&m[2][2]), "{m:?}");
+            assert_eq!(l.vectors()[2][2], 2.0 * scale);
+            assert_eq!(l.unit().log2().fract(), 0.0);
+        }
+        assert!(Lattice::cuboid([1e100; 3])
+            .unwrap()
+            .check_volume_representable()
+            .is_ok());
+        assert!(matches!(
+            Lattice::cuboid([1e110; 3]).unwrap().check_volume_representable(),
+            Err(Error::UnrepresentableVolume { log2 }) if (log2 - 1096.0).abs() < 1.0
+        ));
+        assert!(Lattice::cuboid([1e-110; 3])
+            .unwrap()
+            .check_volume_representable()
+            .is_err());
+        assert!(Lattice::cuboid([1e-110; 2])
+            .unwrap()
+            .check_volume_representable()
+            .is_ok());
     }
 
     #[test]

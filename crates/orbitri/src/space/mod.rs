@@ -8,6 +8,7 @@ mod lattice;
 mod sublattice;
 
 pub use flat_torus::{FlatTorus, FlatTorus2, FlatTorus3, Offset3};
+pub(crate) use lattice::ldexp;
 pub use lattice::{Ladder, Lattice, Level, MAX_COPIES, MAX_DEFECT};
 pub use sublattice::Sublattice;
 
@@ -54,8 +55,14 @@ pub trait OrbitSpace<const N: usize>: Sync + Send {
         a: Lifted<Self::Point, Self::Offset>,
         b: Lifted<Self::Point, Self::Offset>,
     ) -> bool;
-    /// Approximate squared circumradius (infinite for a flat simplex).
+    /// Squared circumradius, to a relative accuracy of about `2^-43` (infinite for a flat
+    /// simplex): from [`OrbitSpace::circumcenter`].
     fn circumradius2(&self, s: &[Lifted<Self::Point, Self::Offset>; N]) -> f64;
+    /// The circumcenter of the lifted simplex relative to its vertex 0, in Cartesian
+    /// coordinates, certified: a floating-point evaluation whose error bound is below
+    /// `2^-44` of its magnitude (and of the simplex's extent) is accepted, otherwise it is
+    /// computed exactly and rounded. Infinite coordinates for a flat simplex.
+    fn circumcenter(&self, s: &[Lifted<Self::Point, Self::Offset>; N]) -> Self::Point;
     /// Number of levels of the covering ladder: level 0 is a covering in which every
     /// non-empty point set has a Delaunay triangulation, each next level has fewer sheets, and
     /// the last is the orbit space itself (1 sheet).

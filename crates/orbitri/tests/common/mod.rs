@@ -79,7 +79,7 @@ pub fn brute_force_check(tri: &PeriodicDelaunay3, input: &[[f64; 3]]) {
     let sheets = tri.sheets() as f64;
     let cells = tri.cells(Copies::Stored);
     let pts: Vec<[f64; 3]> = (0..input.len())
-        .map(|i| tri.points()[tri.vertex_of_input(i) as usize])
+        .map(|i| tri.point(tri.vertex_of_input(i)))
         .collect();
     let mut total = 0.0;
     for c in &cells {
