@@ -251,7 +251,7 @@ impl<const D: usize> Lattice<D> {
     }
 
     /// Volume (area in 2D) of the domain; `inf` or `0` when the doubles cannot hold it (a
-    /// 3D box of side beyond about `5.6e102` or below `2.8e-103`).
+    /// 3D box of side beyond about `5.6e102` or below `6.1e-103`).
     pub fn volume(&self) -> f64 {
         self.measure_to_user(self.volume, D as i32)
     }
