@@ -394,3 +394,57 @@ fn voronoi_sums_with_dummy_construction() {
     assert!(tri.used_dummy_points());
     check_voronoi(&tri);
 }
+
+/// An adversarial set in the unit cell: `kind` 0 pairs one ulp apart, 1 copies shifted by
+/// whole periods (they wrap to near-duplicates), 2 a jittered grid, 3 tight clusters.
+fn adversarial(kind: u8, n: usize, seed: u64, tiny: f64) -> Vec<[f64; 3]> {
+    let base = common::uniform(n, seed, [1.0; 3]);
+    let mut pts = base.clone();
+    match kind {
+        0 => pts.extend(
+            base.iter()
+                .take(n / 3 + 1)
+                .map(|p| p.map(|x| f64::from_bits(x.to_bits() + 1))),
+        ),
+        1 => pts.extend(
+            base.iter()
+                .take(n / 4 + 1)
+                .map(|p| [p[0] + 1.0, p[1] - 2.0, p[2] + 3.0]),
+        ),
+        2 => {
+            let k = 4;
+            pts = (0..k * k * k)
+                .map(|i| {
+                    let g = [i / (k * k), (i / k) % k, i % k];
+                    std::array::from_fn(|c| (g[c] as f64 + 0.5 + tiny * base[i % n][c]) / k as f64)
+                })
+                .collect();
+        }
+        _ => {
+            for (i, b) in base.iter().take(4).enumerate() {
+                for j in 0..5 {
+                    let f = (i * 5 + j + 1) as f64;
+                    pts.push([
+                        b[0] + tiny * f,
+                        b[1] - tiny * f * 0.7,
+                        b[2] + tiny * (f % 3.0),
+                    ]);
+                }
+            }
+        }
+    }
+    pts
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 32, rng_seed: RngSeed::Fixed(20261130), ..ProptestConfig::default() })]
+
+    #[test]
+    fn voronoi_of_adversarial_sets(kind in 0u8..4, n in 2usize..60, seed in any::<u64>(), e in 1i32..1000) {
+        let tiny = 2f64.powi(-e);
+        let pts = adversarial(kind, n, seed, tiny);
+        check_voronoi(&build3(1.0, &pts));
+        let pts2: Vec<[f64; 2]> = pts.iter().map(|p| [p[0], p[1]]).collect();
+        check_voronoi(&build2(1.0, &pts2));
+    }
+}
