@@ -371,8 +371,8 @@ const CENTER_TOLERANCE: f64 = 1.0 / (1u64 << 44) as f64;
 /// Bound: each entry of `d` is within `e_i = 6u·b_i` of the exact lifted difference. For a
 /// polynomial `P` and `Q` its expression evaluated with `+` on magnitudes, `|P(x) − P(x̃)| ≤
 /// Q(|x̃| + e) − Q(|x̃|)` (every monomial holding an error term), and the rounding of `P(x̃)`
-/// is at most `γ_k·Q(|x̃|)`, `k ≤ 8` roundings deep; computing the two `Q` values rounds
-/// at most as much again. Then `x = N/D` with `D = 2·det` is off by at most
+/// is at most `γ_k·Q(|x̃|)`, `k ≤ 8` roundings deep; computing each `Q` value rounds at
+/// most as much again, and widening the inputs by `e` adds `5u` relative. Then `x = N/D` with `D = 2·det` is off by at most
 /// `u|x̃| + (e_N + |x̃|·e_D)/(|D̃| − e_D)` per coordinate.
 fn filtered_center<const D: usize>(
     d: &[[f64; D]; D],
@@ -394,7 +394,8 @@ fn filtered_center<const D: usize>(
         std::array::from_fn(|i| magnitude[i].map(|x| x + 6.0 * U * b[i] * (1.0 + 2.0 * U)));
     let (num0, det0) = polynomials(&magnitude, plus);
     let (num1, det1) = polynomials(&widened, plus);
-    let err = |q0: f64, q1: f64| ((q1 - q0) + 3.0 * gamma * q1) * (1.0 + 4.0 * U);
+    // γ for evaluating P, one for each of the two Q, and the rounding of the widened inputs
+    let err = |q0: f64, q1: f64| ((q1 - q0) + 4.0 * gamma * q1) * (1.0 + 4.0 * U);
     let den = 2.0 * det;
     let err_den = 2.0 * err(det0, det1);
     if !den.is_finite() || !err_den.is_finite() || den.abs() <= 2.0 * err_den {
