@@ -1,0 +1,67 @@
+"""The Python API under misuse and stress: one section per fix of the reliability issue."""
+
+import numpy as np
+import pytest
+
+import orbitri
+
+import freud  # noqa: E402  (a test dependency: pip install .[test])
+
+
+def _canonical(simplices, offsets):
+    """The simplices as a set, each a sorted tuple of (vertex, *offset) translated to a
+    componentwise minimum offset of zero."""
+    o = offsets - offsets.min(axis=1, keepdims=True)
+    rows = np.concatenate([simplices[:, :, None], o], axis=2).tolist()
+    return {tuple(sorted(map(tuple, r))) for r in rows}
+
+
+# --- freud's 2D convention --------------------------------------------------------------
+
+
+def test_freud_2d_points_have_a_zero_third_column():
+    rng = np.random.default_rng(13)
+    xy = rng.random((300, 2)) * [1.5, 1.0]
+    xyz = np.column_stack([xy, np.zeros(len(xy))])
+    want = orbitri.PeriodicDelaunay(xy, [1.5, 1.0])
+    tilted = np.array([[1.5, 0.0], [0.25, 1.0]])
+    for box in (
+        [1.5, 1.0],
+        np.array([[1.5, 0.0], [0.0, 1.0]]),
+        freud.box.Box(1.5, 1.0, is2D=True),
+        freud.box.Box.from_box([1.5, 1.0]),
+    ):
+        tri = orbitri.PeriodicDelaunay(xyz, box)
+        assert tri.dimension == 2 and tri.points.shape == (300, 2)
+        assert _canonical(tri.simplices, tri.offsets) == _canonical(want.simplices, want.offsets)
+    # tilted: a 2 × 2 matrix, or freud's box with xy (freud's tilt: b = (xy·Ly, Ly))
+    for box in (tilted, freud.box.Box(1.5, 1.0, xy=0.25, is2D=True)):
+        vor = orbitri.periodic_voronoi(xyz, box)
+        assert len(vor) == 300 and abs(vor.volumes.sum() - 1.5) < 1e-12
+    # insert and locate take them too
+    ids = tri.insert([[0.2, 0.3, 0.0]])
+    assert ids.tolist() == [300]
+    verts, _, _ = tri.locate([0.2, 0.3, 0.0])
+    assert 300 in verts.tolist()
+
+
+def test_freud_2d_points_off_the_plane_and_mixed_dimensions_are_errors():
+    rng = np.random.default_rng(14)
+    xyz = np.column_stack([rng.random((10, 2)), np.zeros(10)])
+    xyz[7, 2] = 0.5
+    for box in ([1.0, 1.0], np.eye(2), freud.box.Box.square(1.0)):
+        with pytest.raises(ValueError, match=r"2D points must have 2 columns, or 3 whose last is 0.*point 7 has z = 0.5"):
+            orbitri.PeriodicDelaunay(xyz, box)
+    tri = orbitri.PeriodicDelaunay(xyz[:5], [1.0, 1.0])
+    with pytest.raises(ValueError, match="point 2 has z = 0.5"):
+        tri.insert(xyz[5:])
+    assert len(tri.points) == 5
+    # a 3D box for 2D points: no silent cut to the first two axes
+    xy = rng.random((10, 2))
+    for box in (freud.box.Box.cube(1.0), np.eye(3), [1.0, 1.0, 1.0, 0.0, 0.0, 0.0]):
+        with pytest.raises(ValueError, match="a 3D box for 2D points"):
+            orbitri.PeriodicDelaunay(xy, box)
+    with pytest.raises(ValueError, match="a 2D box for 3D points"):
+        orbitri.lattice_matrix(freud.box.Box.square(1.0), 3)
+    # three numbers are read by the points: [Lx, Ly, Lz] in 3D, [Lx, Ly, xy] in 2D
+    assert orbitri.PeriodicDelaunay(xy, [1.0, 1.0, 0.25]).lattice.tolist() == [[1.0, 0.0], [0.25, 1.0]]
