@@ -133,6 +133,9 @@ class PeriodicDelaunay:
     first two columns of such points; a non-zero third coordinate is an error, and so are 2D
     points in a 3D box.
 
+    One object may be used from several threads: reads run together, ``insert``, ``locate``
+    and ``try_one_sheet`` one at a time, each waiting without holding the interpreter.
+
     Arrays follow ``scipy.spatial.Delaunay``: ``simplices`` (C × (D+1) input ids, positively
     oriented), ``offsets`` (C × (D+1) × D: vertex ``k`` of simplex ``c`` lies at
     ``points[simplices[c, k]] + offsets[c, k] @ lattice``), ``neighbors`` (C × (D+1): the
@@ -154,9 +157,14 @@ class PeriodicDelaunay:
         self._cells = None
 
     def _arrays(self):
-        if self._cells is None:
-            self._cells = self._tri.cells()
-        return self._cells
+        # cached with the generation read first: a concurrent insert makes the cache stale
+        # by its generation, never fresh-looking
+        generation = self._tri.generation
+        cached = self._cells
+        if cached is None or cached[0] != generation:
+            cached = (generation, self._tri.cells())
+            self._cells = cached
+        return cached[1]
 
     @property
     def dimension(self) -> int:
@@ -198,6 +206,11 @@ class PeriodicDelaunay:
         return self._tri.is_one_sheeted
 
     @property
+    def number_of_input_points(self) -> int:
+        """How many points were given (construction and ``insert``), duplicates included."""
+        return self._tri.number_of_input_points
+
+    @property
     def duplicates(self) -> np.ndarray:
         """For every input point, the input id of its first occurrence (itself if none)."""
         return self._tri.duplicates
@@ -214,7 +227,6 @@ class PeriodicDelaunay:
     def insert(self, points) -> np.ndarray:
         """Inserts more points (their input ids follow the existing ones); returns for each
         the input id of the vertex it became or coincides with."""
-        self._cells = None
         return self._tri.insert(_points(points, self.dimension))
 
     def locate(self, point):

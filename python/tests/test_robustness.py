@@ -1,5 +1,7 @@
 """The Python API under misuse and stress: one section per fix of the reliability issue."""
 
+import threading
+
 import numpy as np
 import pytest
 
@@ -14,6 +16,16 @@ def _canonical(simplices, offsets):
     o = offsets - offsets.min(axis=1, keepdims=True)
     rows = np.concatenate([simplices[:, :, None], o], axis=2).tolist()
     return {tuple(sorted(map(tuple, r))) for r in rows}
+
+
+def _check_fills_the_box(tri):
+    """Every stored simplex positively oriented, and (1-sheeted) their volumes fill the box."""
+    lifted = tri.points[tri.simplices] + tri.offsets @ tri.lattice
+    d = lifted[:, 1:] - lifted[:, :1]
+    vol = np.linalg.det(d) / (2 if tri.dimension == 2 else 6)
+    assert (vol > 0).all()
+    box = abs(np.linalg.det(tri.lattice))
+    assert abs(vol.sum() - tri.sheets * box) <= 1e-9 * box
 
 
 # --- freud's 2D convention --------------------------------------------------------------
@@ -65,3 +77,50 @@ def test_freud_2d_points_off_the_plane_and_mixed_dimensions_are_errors():
         orbitri.lattice_matrix(freud.box.Box.square(1.0), 3)
     # three numbers are read by the points: [Lx, Ly, Lz] in 3D, [Lx, Ly, xy] in 2D
     assert orbitri.PeriodicDelaunay(xy, [1.0, 1.0, 0.25]).lattice.tolist() == [[1.0, 0.0], [0.25, 1.0]]
+
+
+# --- threads ----------------------------------------------------------------------------
+
+
+def test_one_triangulation_shared_by_threads():
+    rng = np.random.default_rng(15)
+    tri = orbitri.PeriodicDelaunay(rng.random((3000, 3)), [1.0, 1.0, 1.0])
+    batches = [rng.random((400, 3)) for _ in range(12)]
+    errors = []
+    start = threading.Barrier(4)
+
+    def guarded(work):
+        def run():
+            try:
+                start.wait()
+                work()
+            except BaseException as e:  # noqa: BLE001 (reported below)
+                errors.append(e)
+
+        return run
+
+    def writer(k):
+        for b in batches[k::2]:
+            ids = tri.insert(b)
+            assert len(ids) == len(b)
+
+    def reader():
+        for _ in range(6):
+            vor = tri.voronoi()
+            assert abs(vor.volumes.sum() - 1.0) < 1e-9
+            n = len(tri.points)
+            assert len(tri.simplices) == len(tri.offsets)
+            tri.vertex_neighbors(n - 1)
+            tri.locate([0.5, 0.5, 0.5])
+
+    threads = [threading.Thread(target=guarded(f)) for f in (lambda: writer(0), lambda: writer(1), reader, reader)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert errors == []
+    assert tri.number_of_input_points == 3000 + 12 * 400
+    _check_fills_the_box(tri)
+    # the same triangulation as the bulk build of the points in their input order
+    bulk = orbitri.PeriodicDelaunay(tri.points, [1.0, 1.0, 1.0])
+    assert _canonical(tri.simplices, tri.offsets) == _canonical(bulk.simplices, bulk.offsets)

@@ -1,7 +1,16 @@
 //! The Python extension `orbitri._orbitri`: the triangulation and its Voronoi cells for numpy
 //! arrays. The Python package (`python/orbitri`) parses boxes and documents the API; this
 //! module converts arrays (one copy of the input), releases the interpreter during
-//! construction, and turns errors into `ValueError` with the library's message.
+//! construction, insertion and the Voronoi cells, and turns errors into `ValueError` with the
+//! library's message.
+//!
+//! Threads: a triangulation is shared through a read–write lock (readers together, `insert`
+//! and `locate` alone). No thread ever blocks on the lock while attached to
+//! the interpreter (it waits detached, `RwLockExt`), so a holder that reattaches cannot
+//! deadlock.
+
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{RwLock, RwLockReadGuard, RwLockWriteGuard};
 
 use numpy::ndarray::{Array1, Array2, Array3, ArrayView2};
 use numpy::{AllowTypeChange, IntoPyArray, PyArray1, PyArray2, PyArrayLike2};
@@ -9,8 +18,9 @@ use orbitri::periodic::Torus;
 use orbitri::{
     CellMeasures, FlatTorus, PeriodicDelaunay, PeriodicDelaunay2, PeriodicDelaunay3, VoronoiCell,
 };
-use pyo3::exceptions::PyValueError;
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
+use pyo3::sync::RwLockExt;
 use pyo3::types::PyDict;
 
 fn value_error(e: orbitri::Error) -> PyErr {
@@ -65,10 +75,33 @@ fn array2<T: numpy::Element>(
         .into_pyarray(py)
 }
 
-/// A periodic Delaunay triangulation (use `orbitri.PeriodicDelaunay`).
-#[pyclass(module = "orbitri._orbitri")]
+/// A periodic Delaunay triangulation (use `orbitri.PeriodicDelaunay`), shareable between
+/// threads.
+#[pyclass(module = "orbitri._orbitri", frozen)]
 struct Triangulation {
-    tri: Tri,
+    tri: RwLock<Tri>,
+    /// 2 or 3 (never changes: read without the lock).
+    dim: usize,
+    /// Counts the modifications of the cells (for the Python side's cache of `cells()`).
+    generation: AtomicU64,
+}
+
+fn poisoned<T>(_: T) -> PyErr {
+    PyRuntimeError::new_err(
+        "the triangulation is unusable: a call panicked while modifying it (please report)",
+    )
+}
+
+impl Triangulation {
+    /// Shared access; waits (detached) while another thread modifies the triangulation.
+    fn read(&self, py: Python<'_>) -> PyResult<RwLockReadGuard<'_, Tri>> {
+        self.tri.read_py_attached(py).map_err(poisoned)
+    }
+
+    /// Exclusive access; waits (detached) while other threads use the triangulation.
+    fn write(&self, py: Python<'_>) -> PyResult<RwLockWriteGuard<'_, Tri>> {
+        self.tri.write_py_attached(py).map_err(poisoned)
+    }
 }
 
 fn build<const D: usize, const N: usize>(
@@ -84,6 +117,24 @@ where
         PeriodicDelaunay::build(torus, &points)
     })
     .map_err(value_error)
+}
+
+/// Inserts row-major points of dimension `D` one by one, up to the first error; their input
+/// ids.
+fn insert_all<const D: usize, const N: usize>(
+    t: &mut PeriodicDelaunay<D, N>,
+    flat: &[f64],
+) -> orbitri::Result<Vec<i64>>
+where
+    FlatTorus<D>: Torus<D, N>,
+{
+    flat.chunks_exact(D)
+        .map(|q| {
+            let r = t.insert(std::array::from_fn(|c| q[c]))?;
+            let (orbitri::Inserted::New(v) | orbitri::Inserted::Duplicate(v)) = r;
+            Ok(i64::from(t.input_of_vertex(v)))
+        })
+        .collect()
 }
 
 fn simplices<const D: usize, const N: usize>(
@@ -141,104 +192,118 @@ impl Triangulation {
                 )))
             }
         };
-        Ok(Triangulation { tri })
+        Ok(Triangulation {
+            tri: RwLock::new(tri),
+            dim: d,
+            generation: AtomicU64::new(0),
+        })
     }
 
     /// 2 or 3.
     #[getter]
     fn dimension(&self) -> usize {
-        with_tri!(&self.tri, t => t.space().lattice().vectors().len())
+        self.dim
+    }
+
+    /// Counts the modifications of the cells (`insert`).
+    #[getter]
+    fn generation(&self) -> u64 {
+        self.generation.load(Ordering::Acquire)
     }
 
     /// The lattice vectors (rows).
     #[getter]
-    fn lattice<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        with_tri!(&self.tri, t => {
+    fn lattice<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        Ok(with_tri!(&*self.read(py)?, t => {
             let m = t.space().lattice().vectors();
             array2(py, m.len(), m.len(), m.iter().flatten().copied().collect())
-        })
+        }))
     }
 
     /// The input points wrapped into the domain, in input order.
     #[getter]
-    fn points<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        let d = self.dimension();
-        with_tri!(&self.tri, t => {
+    fn points<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let d = self.dim;
+        Ok(with_tri!(&*self.read(py)?, t => {
             let n = t.number_of_input_points();
             let v: Vec<f64> = (0..n)
                 .flat_map(|i| t.points()[t.vertex_of_input(i) as usize])
                 .collect();
             array2(py, n, d, v)
-        })
+        }))
     }
 
     /// (simplices, offsets, neighbors) of every stored cell.
-    fn cells(&self, py: Python<'_>) -> (Py<PyAny>, Py<PyAny>, Py<PyAny>) {
-        with_tri!(&self.tri, t => simplices(py, t))
+    fn cells(&self, py: Python<'_>) -> PyResult<(Py<PyAny>, Py<PyAny>, Py<PyAny>)> {
+        Ok(with_tri!(&*self.read(py)?, t => simplices(py, t)))
     }
 
     #[getter]
-    fn sheets(&self) -> usize {
-        with_tri!(&self.tri, t => t.sheets())
+    fn sheets(&self, py: Python<'_>) -> PyResult<usize> {
+        Ok(with_tri!(&*self.read(py)?, t => t.sheets()))
     }
 
     #[getter]
-    fn is_one_sheeted(&self) -> bool {
-        with_tri!(&self.tri, t => t.is_one_sheeted())
+    fn is_one_sheeted(&self, py: Python<'_>) -> PyResult<bool> {
+        Ok(with_tri!(&*self.read(py)?, t => t.is_one_sheeted()))
+    }
+
+    /// Number of input points given so far.
+    #[getter]
+    fn number_of_input_points(&self, py: Python<'_>) -> PyResult<usize> {
+        Ok(with_tri!(&*self.read(py)?, t => t.number_of_input_points()))
     }
 
     /// For every input point, the input id of its first occurrence.
     #[getter]
-    fn duplicates<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<i64>> {
-        with_tri!(&self.tri, t => t.first_occurrences().into_iter().map(i64::from).collect::<Array1<i64>>().into_pyarray(py))
+    fn duplicates<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<i64>>> {
+        let first = with_tri!(&*self.read(py)?, t => t.first_occurrences());
+        Ok(first
+            .into_iter()
+            .map(i64::from)
+            .collect::<Array1<i64>>()
+            .into_pyarray(py))
     }
 
     #[getter]
-    fn number_of_duplicates(&self) -> usize {
-        with_tri!(&self.tri, t => t.duplicates())
+    fn number_of_duplicates(&self, py: Python<'_>) -> PyResult<usize> {
+        Ok(with_tri!(&*self.read(py)?, t => t.duplicates()))
     }
 
     #[getter]
-    fn number_of_wrapped(&self) -> usize {
-        with_tri!(&self.tri, t => t.wrapped())
+    fn number_of_wrapped(&self, py: Python<'_>) -> PyResult<usize> {
+        Ok(with_tri!(&*self.read(py)?, t => t.wrapped()))
     }
 
     /// Inserts points; returns the input id each became or coincides with.
     fn insert<'py>(
-        &mut self,
+        &self,
         py: Python<'py>,
         points: PyArrayLike2<'_, f64, AllowTypeChange>,
     ) -> PyResult<Bound<'py, PyArray1<i64>>> {
         let p = points.as_array();
-        let ids = with_tri!(&mut self.tri, t => {
-            let d = t.space().lattice().vectors().len();
-            if p.shape()[1] != d {
-                return Err(PyValueError::new_err(format!(
-                    "points must have {d} columns, not {}",
-                    p.shape()[1]
-                )));
-            }
-            let pts = rows(p);
-            let mut ids = Vec::with_capacity(pts.len());
-            for q in pts {
-                let r = t.insert(q).map_err(value_error)?;
-                let point = match r {
-                    orbitri::Inserted::New(v) | orbitri::Inserted::Duplicate(v) => v,
-                };
-                ids.push(i64::from(t.input_of_vertex(point)));
-            }
-            ids
-        });
-        Ok(Array1::from(ids).into_pyarray(py))
+        let d = self.dim;
+        if p.shape()[1] != d {
+            return Err(PyValueError::new_err(format!(
+                "points must have {d} columns, not {}",
+                p.shape()[1]
+            )));
+        }
+        let flat: Vec<f64> = p.iter().copied().collect();
+        let mut guard = self.write(py)?;
+        let tri = &mut *guard;
+        let ids = py.detach(|| with_tri!(tri, t => insert_all(t, &flat)));
+        self.generation.fetch_add(1, Ordering::AcqRel);
+        Ok(Array1::from(ids.map_err(value_error)?).into_pyarray(py))
     }
 
     /// (vertices, offsets, point offset) of the cell containing a point.
     fn locate(
-        &mut self,
+        &self,
         py: Python<'_>,
         point: Vec<f64>,
     ) -> PyResult<(Py<PyAny>, Py<PyAny>, Py<PyAny>)> {
-        with_tri!(&mut self.tri, t => {
+        with_tri!(&mut *self.write(py)?, t => {
             let d = t.space().lattice().vectors().len();
             if point.len() != d {
                 return Err(PyValueError::new_err(format!(
@@ -260,8 +325,8 @@ impl Triangulation {
     }
 
     /// (pairs E×2, shifts E×D, lengths E) of the Delaunay edges, each once.
-    fn edges(&self, py: Python<'_>) -> (Py<PyAny>, Py<PyAny>, Py<PyAny>) {
-        with_tri!(&self.tri, t => {
+    fn edges(&self, py: Python<'_>) -> PyResult<(Py<PyAny>, Py<PyAny>, Py<PyAny>)> {
+        Ok(with_tri!(&*self.read(py)?, t => {
             let e = t.delaunay_edges();
             let d = t.space().lattice().vectors().len();
             let ij: Vec<i64> = e.iter().flat_map(|x| [i64::from(x.i), i64::from(x.j)]).collect();
@@ -272,12 +337,12 @@ impl Triangulation {
                 array2(py, e.len(), d, s).into_any().unbind(),
                 l.into_pyarray(py).into_any().unbind(),
             )
-        })
+        }))
     }
 
     /// (ids, shifts) of the Delaunay neighbours of input point `i`.
     fn vertex_neighbors(&self, py: Python<'_>, i: usize) -> PyResult<(Py<PyAny>, Py<PyAny>)> {
-        with_tri!(&self.tri, t => {
+        with_tri!(&*self.read(py)?, t => {
             if i >= t.number_of_input_points() {
                 return Err(PyValueError::new_err(format!(
                     "point {i} does not exist ({} points)",
@@ -296,13 +361,15 @@ impl Triangulation {
     }
 
     /// The Voronoi cells of the points (computed without holding the interpreter).
-    fn voronoi(&self, py: Python<'_>) -> Voronoi {
-        let cells = match &self.tri {
+    fn voronoi(&self, py: Python<'_>) -> PyResult<Voronoi> {
+        let guard = self.read(py)?;
+        let cells = match &*guard {
             Tri::Two(t) => Cells::Two(py.detach(|| t.voronoi_cells()), t.first_occurrences()),
             Tri::Three(t) => Cells::Three(py.detach(|| t.voronoi_cells()), t.first_occurrences()),
         };
+        drop(guard);
         let per_point = with_cells!(&cells, c, first => PerPoint::of(c, first));
-        Voronoi { cells, per_point }
+        Ok(Voronoi { cells, per_point })
     }
 }
 
