@@ -226,7 +226,20 @@ class PeriodicDelaunay:
 
     def insert(self, points) -> np.ndarray:
         """Inserts more points (their input ids follow the existing ones); returns for each
-        the input id of the vertex it became or coincides with."""
+        the input id of the vertex it became or coincides with.
+
+        All or nothing: every coordinate is checked before any point is inserted. An error
+        names the point by its row in ``points`` (not by the input id it would have had):
+
+        >>> import numpy as np, orbitri
+        >>> tri = orbitri.PeriodicDelaunay([[0.1, 0.2], [0.6, 0.7]], [1.0, 1.0])
+        >>> tri.insert([[0.3, 0.3], [0.4, 0.9], [0.5, np.nan]])
+        Traceback (most recent call last):
+        ...
+        ValueError: point 2: coordinate 1 is NaN, not a finite number
+        >>> tri.number_of_input_points
+        2
+        """
         return self._tri.insert(_points(points, self.dimension))
 
     def locate(self, point):

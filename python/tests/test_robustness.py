@@ -124,3 +124,20 @@ def test_one_triangulation_shared_by_threads():
     # the same triangulation as the bulk build of the points in their input order
     bulk = orbitri.PeriodicDelaunay(tri.points, [1.0, 1.0, 1.0])
     assert _canonical(tri.simplices, tri.offsets) == _canonical(bulk.simplices, bulk.offsets)
+
+
+# --- insert is all or nothing ---------------------------------------------------------
+
+
+def test_insert_checks_every_point_before_inserting_any():
+    rng = np.random.default_rng(11)
+    tri = orbitri.PeriodicDelaunay(rng.random((20, 2)), [1.0, 1.0])
+    cells = _canonical(tri.simplices, tri.offsets)
+    # the error names the row of the batch (not the input id it would have had: 22)
+    with pytest.raises(ValueError, match=r"^point 2: coordinate 1 is NaN, not a finite number$"):
+        tri.insert([[0.1, 0.2], [0.3, 0.4], [0.5, np.nan]])
+    with pytest.raises(ValueError, match=r"^point 1: coordinate 0 is -inf"):
+        tri.insert(np.array([[0.1, 0.2], [-np.inf, 0.4]]))
+    assert tri.number_of_input_points == 20 and len(tri.points) == 20
+    assert _canonical(tri.simplices, tri.offsets) == cells
+    assert tri.insert([[0.1, 0.2], [0.3, 0.4]]).tolist() == [20, 21]

@@ -119,20 +119,34 @@ where
     .map_err(value_error)
 }
 
-/// Inserts row-major points of dimension `D` one by one, up to the first error; their input
-/// ids.
+/// The first non-finite coordinate of row-major points of dimension `d`, as the library
+/// names it, with the row in the batch as the point.
+fn check_finite(flat: &[f64], d: usize) -> PyResult<()> {
+    match flat.iter().position(|v| !v.is_finite()) {
+        None => Ok(()),
+        Some(k) => Err(value_error(orbitri::Error::NonFiniteCoordinate {
+            index: k / d,
+            axis: k % d,
+            value: flat[k],
+        })),
+    }
+}
+
+/// Inserts row-major points of dimension `D` (all finite); their input ids.
 fn insert_all<const D: usize, const N: usize>(
     t: &mut PeriodicDelaunay<D, N>,
     flat: &[f64],
-) -> orbitri::Result<Vec<i64>>
+) -> Vec<i64>
 where
     FlatTorus<D>: Torus<D, N>,
 {
     flat.chunks_exact(D)
         .map(|q| {
-            let r = t.insert(std::array::from_fn(|c| q[c]))?;
+            let r = t
+                .insert(std::array::from_fn(|c| q[c]))
+                .expect("checked finite");
             let (orbitri::Inserted::New(v) | orbitri::Inserted::Duplicate(v)) = r;
-            Ok(i64::from(t.input_of_vertex(v)))
+            i64::from(t.input_of_vertex(v))
         })
         .collect()
 }
@@ -275,7 +289,8 @@ impl Triangulation {
         Ok(with_tri!(&*self.read(py)?, t => t.wrapped()))
     }
 
-    /// Inserts points; returns the input id each became or coincides with.
+    /// Inserts points, all or none: every coordinate is checked first (an error names the
+    /// row of `points` and the axis); returns the input id each became or coincides with.
     fn insert<'py>(
         &self,
         py: Python<'py>,
@@ -290,11 +305,12 @@ impl Triangulation {
             )));
         }
         let flat: Vec<f64> = p.iter().copied().collect();
+        check_finite(&flat, d)?;
         let mut guard = self.write(py)?;
         let tri = &mut *guard;
         let ids = py.detach(|| with_tri!(tri, t => insert_all(t, &flat)));
         self.generation.fetch_add(1, Ordering::AcqRel);
-        Ok(Array1::from(ids.map_err(value_error)?).into_pyarray(py))
+        Ok(Array1::from(ids).into_pyarray(py))
     }
 
     /// (vertices, offsets, point offset) of the cell containing a point.
