@@ -256,8 +256,11 @@ class PeriodicDelaunay:
         return self._tri.edges()
 
     def vertex_neighbors(self, i: int):
-        """The Delaunay neighbours of input point ``i``: (ids, shifts)."""
-        return self._tri.vertex_neighbors(int(i))
+        """The Delaunay neighbours of input point ``i``: (ids, shifts).
+
+        ``i`` is an integer (Python's or numpy's; a float or a string is a ``TypeError``)
+        from 0 to ``number_of_input_points - 1``, else ``IndexError`` (no negative ids)."""
+        return self._tri.vertex_neighbors(i)
 
     def voronoi(self) -> Voronoi:
         """The periodic Voronoi cells (volumes, neighbours with shifts and face areas,

@@ -1,4 +1,4 @@
-from typing import Any
+from typing import Any, SupportsIndex
 
 import numpy as np
 import numpy.typing as npt
@@ -44,7 +44,7 @@ class PeriodicDelaunay:
         self,
     ) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int32], npt.NDArray[np.float64]]: ...
     def vertex_neighbors(
-        self, i: int
+        self, i: SupportsIndex
     ) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int32]]: ...
     def voronoi(self) -> Voronoi: ...
 

@@ -1,6 +1,6 @@
 """The compiled core (Rust, PyO3). Use the classes of `orbitri`, not these directly."""
 
-from typing import Any
+from typing import Any, SupportsIndex
 
 import numpy as np
 import numpy.typing as npt
@@ -40,7 +40,7 @@ class Triangulation:
         self,
     ) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int32], npt.NDArray[np.float64]]: ...
     def vertex_neighbors(
-        self, i: int
+        self, i: SupportsIndex
     ) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int32]]: ...
     def voronoi(self) -> Voronoi: ...
 

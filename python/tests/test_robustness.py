@@ -141,3 +141,22 @@ def test_insert_checks_every_point_before_inserting_any():
     assert tri.number_of_input_points == 20 and len(tri.points) == 20
     assert _canonical(tri.simplices, tri.offsets) == cells
     assert tri.insert([[0.1, 0.2], [0.3, 0.4]]).tolist() == [20, 21]
+
+
+# --- vertex_neighbors takes integer ids -------------------------------------------------
+
+
+def test_vertex_neighbors_takes_integers_in_range():
+    rng = np.random.default_rng(12)
+    tri = orbitri.PeriodicDelaunay(rng.random((50, 3)), [1.0, 1.0, 1.0])
+    ids, shifts = tri.vertex_neighbors(3)
+    for same in (np.int64(3), np.int32(3), np.uint8(3)):
+        i2, s2 = tri.vertex_neighbors(same)
+        np.testing.assert_array_equal(i2, ids)
+        np.testing.assert_array_equal(s2, shifts)
+    for bad in (-1, 50, 2**70, np.int64(-5)):
+        with pytest.raises(IndexError, match=rf"point {bad} does not exist: the ids of the 50 input points are 0 to 49"):
+            tri.vertex_neighbors(bad)
+    for bad in (1.5, 3.0, np.float64(3.0), "3", None):
+        with pytest.raises(TypeError):
+            tri.vertex_neighbors(bad)

@@ -18,7 +18,7 @@ use orbitri::periodic::Torus;
 use orbitri::{
     CellMeasures, FlatTorus, PeriodicDelaunay, PeriodicDelaunay2, PeriodicDelaunay3, VoronoiCell,
 };
-use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::exceptions::{PyIndexError, PyOverflowError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::sync::RwLockExt;
 use pyo3::types::PyDict;
@@ -356,15 +356,33 @@ impl Triangulation {
         }))
     }
 
-    /// (ids, shifts) of the Delaunay neighbours of input point `i`.
-    fn vertex_neighbors(&self, py: Python<'_>, i: usize) -> PyResult<(Py<PyAny>, Py<PyAny>)> {
-        with_tri!(&*self.read(py)?, t => {
-            if i >= t.number_of_input_points() {
-                return Err(PyValueError::new_err(format!(
-                    "point {i} does not exist ({} points)",
-                    t.number_of_input_points()
-                )));
-            }
+    /// (ids, shifts) of the Delaunay neighbours of input point `i`: any integer (Python's
+    /// or numpy's, not a float or a string), `0 <= i < number_of_input_points`.
+    fn vertex_neighbors(
+        &self,
+        py: Python<'_>,
+        i: &Bound<'_, PyAny>,
+    ) -> PyResult<(Py<PyAny>, Py<PyAny>)> {
+        let guard = self.read(py)?;
+        let n = with_tri!(&*guard, t => t.number_of_input_points());
+        let out_of_range = || {
+            PyIndexError::new_err(format!(
+                "point {} does not exist: the ids of the {n} input points are 0 to {}",
+                i.str().map_or_else(|_| "?".into(), |s| s.to_string()),
+                n as i64 - 1
+            ))
+        };
+        // `__index__`: a float or a string is a TypeError, a huge int out of range
+        let i = match i.extract::<i64>() {
+            Ok(i) => i,
+            Err(e) if e.is_instance_of::<PyOverflowError>(py) => return Err(out_of_range()),
+            Err(e) => return Err(e),
+        };
+        let i = usize::try_from(i)
+            .ok()
+            .filter(|&i| i < n)
+            .ok_or_else(out_of_range)?;
+        with_tri!(&*guard, t => {
             let nb = t.vertex_neighbors(i);
             let d = t.space().lattice().vectors().len();
             let ids: Vec<i64> = nb.iter().map(|x| i64::from(x.0)).collect();
