@@ -205,6 +205,28 @@ class PeriodicDelaunay:
     def is_one_sheeted(self) -> bool:
         return self._tri.is_one_sheeted
 
+    def try_one_sheet(self) -> bool:
+        """Moves a triangulation still in a covering space (``sheets > 1``) to the torus if
+        its projection there is already a simplicial complex; returns ``is_one_sheeted``.
+
+        The construction does this at its end; after ``insert`` it is the caller's choice:
+        points inserted a few at a time can stay in the covering although their projection
+        is fine, and a 1-sheeted triangulation is smaller. Later insertions stay correct
+        either way.
+
+        >>> import numpy as np, orbitri
+        >>> rng = np.random.default_rng(0)
+        >>> clusters = rng.random((8, 1, 2)) + 0.03 * rng.standard_normal((8, 30, 2))
+        >>> pts = clusters.reshape(-1, 2) % 1.0
+        >>> tri = orbitri.PeriodicDelaunay(pts[:1], [1.0, 1.0])
+        >>> ids = tri.insert(pts[1:])
+        >>> tri.sheets, orbitri.PeriodicDelaunay(pts, [1.0, 1.0]).sheets
+        (4, 1)
+        >>> tri.try_one_sheet(), tri.sheets
+        (True, 1)
+        """
+        return self._tri.try_one_sheet()
+
     @property
     def number_of_input_points(self) -> int:
         """How many points were given (construction and ``insert``), duplicates included."""

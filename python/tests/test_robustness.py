@@ -160,3 +160,34 @@ def test_vertex_neighbors_takes_integers_in_range():
     for bad in (1.5, 3.0, np.float64(3.0), "3", None):
         with pytest.raises(TypeError):
             tri.vertex_neighbors(bad)
+
+
+# --- try_one_sheet after incremental insertion -------------------------------------------
+
+
+def test_try_one_sheet_brings_clustered_batches_to_the_bulk_result():
+    # 2D clustered points: 8 clusters of 30 points (σ = 0.03) in a unit square, inserted
+    # in 4 batches of about 60 after a first point; the bulk build of the same points ends
+    # in the torus (1 sheet), the incremental one stays in the 4-sheeted covering
+    rng = np.random.default_rng(0)
+    centres = rng.random((8, 2))
+    pts = (centres[:, None, :] + 0.03 * rng.standard_normal((8, 30, 2))).reshape(-1, 2) % 1.0
+    rng.shuffle(pts)
+    bulk = orbitri.PeriodicDelaunay(pts, [1.0, 1.0])
+    assert bulk.sheets == 1
+    tri = orbitri.PeriodicDelaunay(pts[:1], [1.0, 1.0])
+    for batch in np.array_split(pts[1:], 4):
+        tri.insert(batch)
+    assert tri.sheets == 4 and not tri.is_one_sheeted
+    _check_fills_the_box(tri)
+    assert tri.try_one_sheet() is True
+    assert tri.sheets == 1 and tri.is_one_sheeted
+    _check_fills_the_box(tri)
+    # the same Delaunay triangulation as the bulk build's (the points are in general
+    # position: it is unique), with the same input ids
+    np.testing.assert_array_equal(tri.points, bulk.points)
+    assert len(tri.simplices) == len(bulk.simplices)
+    assert _canonical(tri.simplices, tri.offsets) == _canonical(bulk.simplices, bulk.offsets)
+    # and it stays correct after more insertions
+    tri.insert(rng.random((30, 2)))
+    _check_fills_the_box(tri)

@@ -4,8 +4,8 @@
 //! construction, insertion and the Voronoi cells, and turns errors into `ValueError` with the
 //! library's message.
 //!
-//! Threads: a triangulation is shared through a read–write lock (readers together, `insert`
-//! and `locate` alone). No thread ever blocks on the lock while attached to
+//! Threads: a triangulation is shared through a read–write lock (readers together, `insert`,
+//! `locate` and `try_one_sheet` alone). No thread ever blocks on the lock while attached to
 //! the interpreter (it waits detached, `RwLockExt`), so a holder that reattaches cannot
 //! deadlock.
 
@@ -219,7 +219,7 @@ impl Triangulation {
         self.dim
     }
 
-    /// Counts the modifications of the cells (`insert`).
+    /// Counts the modifications of the cells (`insert`, `try_one_sheet`).
     #[getter]
     fn generation(&self) -> u64 {
         self.generation.load(Ordering::Acquire)
@@ -260,6 +260,16 @@ impl Triangulation {
     #[getter]
     fn is_one_sheeted(&self, py: Python<'_>) -> PyResult<bool> {
         Ok(with_tri!(&*self.read(py)?, t => t.is_one_sheeted()))
+    }
+
+    /// Moves a triangulation still in a covering space to the 1-sheeted torus if its
+    /// projection is a simplicial complex; whether it is 1-sheeted.
+    fn try_one_sheet(&self, py: Python<'_>) -> PyResult<bool> {
+        let mut guard = self.write(py)?;
+        let tri = &mut *guard;
+        let one = py.detach(|| with_tri!(tri, t => t.try_one_sheet()));
+        self.generation.fetch_add(1, Ordering::AcqRel);
+        Ok(one)
     }
 
     /// Number of input points given so far.
