@@ -126,7 +126,8 @@ class PeriodicDelaunay:
 
     Points outside the box are wrapped into it; a point that coincides with an earlier one
     (also through a period) is a duplicate: it maps to its first occurrence and is listed in
-    ``duplicates``. Construction runs without holding the interpreter.
+    ``duplicates``. Construction runs without holding the interpreter, and Ctrl-C stops it
+    (``KeyboardInterrupt``) within a fraction of a second.
 
     freud's 2D systems (a 2D box, N × 3 points whose last column is 0) are 2D: a box that is
     2D by itself (``[Lx, Ly]``, a 2 × 2 matrix, a ``freud.box.Box`` with ``is2D``) takes the
@@ -286,7 +287,8 @@ class PeriodicDelaunay:
 
     def voronoi(self) -> Voronoi:
         """The periodic Voronoi cells (volumes, neighbours with shifts and face areas,
-        centroids, and the cells themselves on demand)."""
+        centroids, and the cells themselves on demand). Computed without holding the
+        interpreter; Ctrl-C stops it."""
         return self._tri.voronoi()
 
 

@@ -1,6 +1,9 @@
 """The Python API under misuse and stress: one section per fix of the reliability issue."""
 
+import os
+import signal
 import threading
+import time
 
 import numpy as np
 import pytest
@@ -191,3 +194,44 @@ def test_try_one_sheet_brings_clustered_batches_to_the_bulk_result():
     # and it stays correct after more insertions
     tri.insert(rng.random((30, 2)))
     _check_fills_the_box(tri)
+
+
+# --- Ctrl-C -----------------------------------------------------------------------------
+
+
+def _latency_of_ctrl_c(call, delay=0.3):
+    """Sends SIGINT to this process `delay` seconds into `call` (which must take longer);
+    returns the seconds from the signal to the KeyboardInterrupt."""
+    fired = []
+
+    def fire():
+        fired.append(time.perf_counter())
+        os.kill(os.getpid(), signal.SIGINT)
+
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    timer = threading.Timer(delay, fire)
+    try:
+        timer.start()
+        with pytest.raises(KeyboardInterrupt):
+            call()
+        return time.perf_counter() - fired[0]
+    finally:
+        timer.cancel()
+        timer.join()
+        signal.signal(signal.SIGINT, previous)
+
+
+def test_ctrl_c_stops_the_construction():
+    pts = np.random.default_rng(16).random((1_000_000, 3))
+    latency = _latency_of_ctrl_c(lambda: orbitri.PeriodicDelaunay(pts, [1.0, 1.0, 1.0]))
+    assert latency < 1.0, f"KeyboardInterrupt {latency:.2f} s after the signal"
+
+
+def test_ctrl_c_stops_the_voronoi_cells():
+    pts = np.random.default_rng(17).random((200_000, 3))
+    tri = orbitri.PeriodicDelaunay(pts, [1.0, 1.0, 1.0])
+    latency = _latency_of_ctrl_c(tri.voronoi)
+    assert latency < 1.0, f"KeyboardInterrupt {latency:.2f} s after the signal"
+    # the triangulation is untouched (an insertion waits for the abandoned computation)
+    assert tri.insert([[0.5, 0.5, 0.5]]).tolist() == [200_000]
+    assert tri.number_of_input_points == 200_001

@@ -8,15 +8,24 @@
 //! `locate` and `try_one_sheet` alone). No thread ever blocks on the lock while attached to
 //! the interpreter (it waits detached, `RwLockExt`), so a holder that reattaches cannot
 //! deadlock.
+//!
+//! Ctrl-C: the construction and the Voronoi cells run detached, on the main thread on a
+//! helper thread while the main one runs the signal handlers every `POLL` (`interruptible`).
+//! A handler's exception (`KeyboardInterrupt`) is raised at once; the computation sees its
+//! stop flag at its next poll (the library's progress callback, `voronoi_cells_until`) and
+//! ends in the background.
 
-use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::{RwLock, RwLockReadGuard, RwLockWriteGuard};
+use std::ops::ControlFlow;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::{mpsc, Arc, Mutex, RwLock, RwLockReadGuard, RwLockWriteGuard};
+use std::time::Duration;
 
 use numpy::ndarray::{Array1, Array2, Array3, ArrayView2};
 use numpy::{AllowTypeChange, IntoPyArray, PyArray1, PyArray2, PyArrayLike2};
 use orbitri::periodic::Torus;
 use orbitri::{
-    CellMeasures, FlatTorus, PeriodicDelaunay, PeriodicDelaunay2, PeriodicDelaunay3, VoronoiCell,
+    BuildOptions, CellMeasures, FlatTorus, PeriodicDelaunay, PeriodicDelaunay2, PeriodicDelaunay3,
+    VoronoiCell,
 };
 use pyo3::exceptions::{PyIndexError, PyOverflowError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
@@ -25,6 +34,64 @@ use pyo3::types::PyDict;
 
 fn value_error(e: orbitri::Error) -> PyErr {
     PyValueError::new_err(e.to_string())
+}
+
+/// How often the main thread runs the signal handlers while a long computation runs.
+const POLL: Duration = Duration::from_millis(50);
+
+/// Inputs smaller than this (points, vertices) are computed on the calling thread: they end
+/// sooner than a helper thread would be worth.
+const SMALL: usize = 20_000;
+
+/// Runs `work` (of `size` points) without the interpreter and answers Ctrl-C.
+///
+/// On the main thread (the only one that receives signals), unless the input is small,
+/// `work` runs on a helper thread while this one waits detached and runs the signal handlers
+/// every `POLL`. Once a handler raises (`KeyboardInterrupt`), the call returns that
+/// exception at once: `work` sees `stop` raised at its next poll and ends in the background,
+/// its result dropped. Elsewhere `work` runs here, and `stop` is never raised.
+fn interruptible<T: Send + 'static>(
+    py: Python<'_>,
+    size: usize,
+    work: impl FnOnce(&AtomicBool) -> PyResult<T> + Send + 'static,
+) -> PyResult<T> {
+    let threading = py.import("threading")?;
+    let main = threading
+        .call_method0("main_thread")?
+        .is(&threading.call_method0("current_thread")?);
+    if !main || size < SMALL {
+        return py.detach(|| work(&AtomicBool::new(false)));
+    }
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = Arc::clone(&stop);
+    let (tx, rx) = mpsc::channel();
+    let worker = std::thread::Builder::new()
+        .name("orbitri".into())
+        // the main thread's size: the work would have run there
+        .stack_size(8 << 20)
+        .spawn(move || {
+            let _ = tx.send(work(&flag));
+        })
+        .map_err(|e| PyRuntimeError::new_err(format!("cannot start a thread: {e}")))?;
+    // a `Receiver` is not `Sync`: the lock (only ever taken here) lets the wait run detached
+    let rx = Mutex::new(rx);
+    loop {
+        let next = py.detach(|| rx.lock().expect("one waiter").recv_timeout(POLL));
+        match next {
+            Ok(result) => return result,
+            Err(mpsc::RecvTimeoutError::Timeout) => {
+                if let Err(e) = py.check_signals() {
+                    stop.store(true, Ordering::Relaxed);
+                    return Err(e);
+                }
+            }
+            // `work` panicked: raise its panic here
+            Err(mpsc::RecvTimeoutError::Disconnected) => match worker.join() {
+                Err(panic) => std::panic::resume_unwind(panic),
+                Ok(()) => unreachable!("the worker sends its result before it ends"),
+            },
+        }
+    }
 }
 
 /// The rows of an `(N, D)` array as points (the one copy of the input).
@@ -79,7 +146,8 @@ fn array2<T: numpy::Element>(
 /// threads.
 #[pyclass(module = "orbitri._orbitri", frozen)]
 struct Triangulation {
-    tri: RwLock<Tri>,
+    /// Shared with a computation that may outlive an interrupted call (`voronoi`).
+    tri: Arc<RwLock<Tri>>,
     /// 2 or 3 (never changes: read without the lock).
     dim: usize,
     /// Counts the modifications of the cells (for the Python side's cache of `cells()`).
@@ -112,11 +180,17 @@ fn build<const D: usize, const N: usize>(
 where
     FlatTorus<D>: Torus<D, N>,
 {
-    py.detach(move || {
-        let torus = FlatTorus::<D>::triclinic(lattice)?;
-        PeriodicDelaunay::build(torus, &points)
+    interruptible(py, points.len(), move |stop| {
+        let torus = FlatTorus::<D>::triclinic(lattice).map_err(value_error)?;
+        PeriodicDelaunay::build_with(torus, &points, BuildOptions::default(), |_| {
+            if stop.load(Ordering::Relaxed) {
+                ControlFlow::Break(())
+            } else {
+                ControlFlow::Continue(())
+            }
+        })
+        .map_err(value_error)
     })
-    .map_err(value_error)
 }
 
 /// The first non-finite coordinate of row-major points of dimension `d`, as the library
@@ -207,7 +281,7 @@ impl Triangulation {
             }
         };
         Ok(Triangulation {
-            tri: RwLock::new(tri),
+            tri: Arc::new(RwLock::new(tri)),
             dim: d,
             generation: AtomicU64::new(0),
         })
@@ -404,14 +478,24 @@ impl Triangulation {
         })
     }
 
-    /// The Voronoi cells of the points (computed without holding the interpreter).
+    /// The Voronoi cells of the points (computed without holding the interpreter; Ctrl-C
+    /// stops them).
     fn voronoi(&self, py: Python<'_>) -> PyResult<Voronoi> {
-        let guard = self.read(py)?;
-        let cells = match &*guard {
-            Tri::Two(t) => Cells::Two(py.detach(|| t.voronoi_cells()), t.first_occurrences()),
-            Tri::Three(t) => Cells::Three(py.detach(|| t.voronoi_cells()), t.first_occurrences()),
-        };
-        drop(guard);
+        let vertices = with_tri!(&*self.read(py)?, t => t.number_of_vertices());
+        let shared = Arc::clone(&self.tri);
+        let cells = interruptible(py, vertices, move |stop| {
+            let interrupt = || stop.load(Ordering::Relaxed);
+            Ok(match &*shared.read().map_err(poisoned)? {
+                Tri::Two(t) => Cells::Two(
+                    t.voronoi_cells_until(&interrupt).map_err(value_error)?,
+                    t.first_occurrences(),
+                ),
+                Tri::Three(t) => Cells::Three(
+                    t.voronoi_cells_until(&interrupt).map_err(value_error)?,
+                    t.first_occurrences(),
+                ),
+            })
+        })?;
         let per_point = with_cells!(&cells, c, first => PerPoint::of(c, first));
         Ok(Voronoi { cells, per_point })
     }
