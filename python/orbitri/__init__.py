@@ -35,17 +35,26 @@ def lattice_matrix(box, dimension: int) -> np.ndarray:
     * lengths and tilt factors ``[Lx, Ly, Lz, xy, xz, yz]`` (2D: ``[Lx, Ly, xy]``), as freud
       defines them: ``a = (Lx, 0, 0)``, ``b = (xy·Ly, Ly, 0)``, ``c = (xz·Lz, yz·Lz, Lz)``.
       LAMMPS's tilts are lengths: divide them by ``Ly`` (``xy``) or ``Lz`` (``xz``, ``yz``);
-    * a ``freud.box.Box`` (anything with ``to_matrix()``, whose columns are the vectors).
+    * a ``freud.box.Box`` (anything with ``to_matrix()``, whose columns are the vectors; a 2D
+      one, ``is2D``, gives its 2 × 2 part).
+
+    A box that is 2D by itself (``[Lx, Ly]``, a 2 × 2 matrix, a 2D freud box) for
+    ``dimension`` 3, or 3D by itself (six numbers, a 3 × 3 matrix, a 3D freud box) for
+    ``dimension`` 2, is a ``ValueError``. Three numbers are ``[Lx, Ly, Lz]`` for
+    ``dimension`` 3 and ``[Lx, Ly, xy]`` for ``dimension`` 2.
 
     >>> lattice_matrix([2.0, 1.0, 1.0, 0.5, 0.0, 0.0], 3)[1]
     array([0.5, 1. , 0. ])
+    >>> lattice_matrix([2.0, 1.0, 0.5], 2)
+    array([[2. , 0. ],
+           [0.5, 1. ]])
     """
-    if hasattr(box, "to_matrix"):
-        m = np.asarray(box.to_matrix(), dtype=float).T
-        if m.shape[0] == 3 and dimension == 2:
-            m = m[:2, :2]
-        box = m
-    b = np.asarray(box, dtype=float)
+    b, own = _box(box)
+    if own is not None and own != dimension:
+        raise ValueError(
+            f"a {own}D box for {dimension}D points: the box and the points "
+            f"must have the same dimension"
+        )
     if b.ndim == 2:
         if b.shape != (dimension, dimension):
             raise ValueError(
@@ -75,10 +84,39 @@ def lattice_matrix(box, dimension: int) -> np.ndarray:
     )
 
 
-def _points(points) -> np.ndarray:
+def _box(box):
+    """The box as an array of numbers (lengths and tilts) or a matrix of row vectors, and
+    the dimension it states by itself: 2, 3, or None for three numbers (``[Lx, Ly, Lz]`` or
+    ``[Lx, Ly, xy]``: the points tell) and shapes ``lattice_matrix`` rejects."""
+    if hasattr(box, "to_matrix"):
+        m = np.asarray(box.to_matrix(), dtype=float).T
+        is2d = getattr(box, "is2D", None)
+        if is2d is None:  # not freud's: a 2 × 2 matrix, or freud's 2D layout (Lz = 0)
+            is2d = m.shape == (2, 2) or (m.shape == (3, 3) and m[2, 2] == 0)
+        return (m[:2, :2], 2) if is2d else (m, 3)
+    b = np.asarray(box, dtype=float)
+    if b.ndim == 2 and b.shape in ((2, 2), (3, 3)):
+        return b, b.shape[0]
+    if b.ndim == 1 and b.size in (2, 6):
+        return b, 2 if b.size == 2 else 3
+    return b, None
+
+
+def _points(points, dimension=None) -> np.ndarray:
+    """Points as an (N, 2) or (N, 3) float array. In 2D (``dimension`` 2), freud's (N, 3)
+    points give their first two columns; their third must be 0."""
     p = np.asarray(points, dtype=float)
     if p.ndim != 2 or p.shape[1] not in (2, 3):
         raise ValueError(f"points must be an array of shape (N, 2) or (N, 3), not {p.shape}")
+    if dimension == 2 and p.shape[1] == 3:
+        nonzero = np.flatnonzero(p[:, 2] != 0)
+        if nonzero.size:
+            k = nonzero[0]
+            raise ValueError(
+                f"2D points must have 2 columns, or 3 whose last is 0 (freud's 2D systems): "
+                f"point {k} has z = {p[k, 2]}"
+            )
+        p = p[:, :2]
     return p
 
 
@@ -88,7 +126,16 @@ class PeriodicDelaunay:
 
     Points outside the box are wrapped into it; a point that coincides with an earlier one
     (also through a period) is a duplicate: it maps to its first occurrence and is listed in
-    ``duplicates``. Construction runs without holding the interpreter.
+    ``duplicates``. Construction runs without holding the interpreter, and Ctrl-C stops it
+    (``KeyboardInterrupt``) within a fraction of a second.
+
+    freud's 2D systems (a 2D box, N × 3 points whose last column is 0) are 2D: a box that is
+    2D by itself (``[Lx, Ly]``, a 2 × 2 matrix, a ``freud.box.Box`` with ``is2D``) takes the
+    first two columns of such points; a non-zero third coordinate is an error, and so are 2D
+    points in a 3D box.
+
+    One object may be used from several threads: reads run together, ``insert``, ``locate``
+    and ``try_one_sheet`` one at a time, each waiting without holding the interpreter.
 
     Arrays follow ``scipy.spatial.Delaunay``: ``simplices`` (C × (D+1) input ids, positively
     oriented), ``offsets`` (C × (D+1) × D: vertex ``k`` of simplex ``c`` lies at
@@ -101,17 +148,24 @@ class PeriodicDelaunay:
     ...                                + [[0.05 * i, 0.5] for i in range(20)], [1.0, 1.0])
     >>> int(tri.duplicates[4]), tri.simplices.shape[1]
     (0, 3)
+    >>> orbitri.PeriodicDelaunay([[0.1, 0.2, 0.0], [0.6, 0.7, 0.0]], [1.0, 1.0]).dimension
+    2
     """
 
     def __init__(self, points, box):
-        p = _points(points)
+        p = _points(points, _box(box)[1])
         self._tri = _Triangulation(p, lattice_matrix(box, p.shape[1]))
         self._cells = None
 
     def _arrays(self):
-        if self._cells is None:
-            self._cells = self._tri.cells()
-        return self._cells
+        # cached with the generation read first: a concurrent insert makes the cache stale
+        # by its generation, never fresh-looking
+        generation = self._tri.generation
+        cached = self._cells
+        if cached is None or cached[0] != generation:
+            cached = (generation, self._tri.cells())
+            self._cells = cached
+        return cached[1]
 
     @property
     def dimension(self) -> int:
@@ -152,6 +206,33 @@ class PeriodicDelaunay:
     def is_one_sheeted(self) -> bool:
         return self._tri.is_one_sheeted
 
+    def try_one_sheet(self) -> bool:
+        """Moves a triangulation still in a covering space (``sheets > 1``) to the torus if
+        its projection there is already a simplicial complex; returns ``is_one_sheeted``.
+
+        The construction does this at its end; after ``insert`` it is the caller's choice:
+        points inserted a few at a time can stay in the covering although their projection
+        is fine, and a 1-sheeted triangulation is smaller. Later insertions stay correct
+        either way.
+
+        >>> import numpy as np, orbitri
+        >>> rng = np.random.default_rng(0)
+        >>> clusters = rng.random((8, 1, 2)) + 0.03 * rng.standard_normal((8, 30, 2))
+        >>> pts = clusters.reshape(-1, 2) % 1.0
+        >>> tri = orbitri.PeriodicDelaunay(pts[:1], [1.0, 1.0])
+        >>> ids = tri.insert(pts[1:])
+        >>> tri.sheets, orbitri.PeriodicDelaunay(pts, [1.0, 1.0]).sheets
+        (4, 1)
+        >>> tri.try_one_sheet(), tri.sheets
+        (True, 1)
+        """
+        return self._tri.try_one_sheet()
+
+    @property
+    def number_of_input_points(self) -> int:
+        """How many points were given (construction and ``insert``), duplicates included."""
+        return self._tri.number_of_input_points
+
     @property
     def duplicates(self) -> np.ndarray:
         """For every input point, the input id of its first occurrence (itself if none)."""
@@ -168,14 +249,29 @@ class PeriodicDelaunay:
 
     def insert(self, points) -> np.ndarray:
         """Inserts more points (their input ids follow the existing ones); returns for each
-        the input id of the vertex it became or coincides with."""
-        self._cells = None
-        return self._tri.insert(_points(points))
+        the input id of the vertex it became or coincides with.
+
+        All or nothing: every coordinate is checked before any point is inserted. An error
+        names the point by its row in ``points`` (not by the input id it would have had):
+
+        >>> import numpy as np, orbitri
+        >>> tri = orbitri.PeriodicDelaunay([[0.1, 0.2], [0.6, 0.7]], [1.0, 1.0])
+        >>> tri.insert([[0.3, 0.3], [0.4, 0.9], [0.5, np.nan]])
+        Traceback (most recent call last):
+        ...
+        ValueError: point 2: coordinate 1 is NaN, not a finite number
+        >>> tri.number_of_input_points
+        2
+        """
+        return self._tri.insert(_points(points, self.dimension))
 
     def locate(self, point):
         """The simplex containing ``point``: (vertex ids, their offsets, the point's offset
         in that simplex's frame)."""
-        return self._tri.locate([float(x) for x in point])
+        q = [float(x) for x in point]
+        if len(q) == 3 and self.dimension == 2:
+            q = _points([q], 2)[0].tolist()
+        return self._tri.locate(q)
 
     def edges(self):
         """The Delaunay edges, each once: (pairs E × 2, shifts E × D, lengths E); the
@@ -183,12 +279,16 @@ class PeriodicDelaunay:
         return self._tri.edges()
 
     def vertex_neighbors(self, i: int):
-        """The Delaunay neighbours of input point ``i``: (ids, shifts)."""
-        return self._tri.vertex_neighbors(int(i))
+        """The Delaunay neighbours of input point ``i``: (ids, shifts).
+
+        ``i`` is an integer (Python's or numpy's; a float or a string is a ``TypeError``)
+        from 0 to ``number_of_input_points - 1``, else ``IndexError`` (no negative ids)."""
+        return self._tri.vertex_neighbors(i)
 
     def voronoi(self) -> Voronoi:
         """The periodic Voronoi cells (volumes, neighbours with shifts and face areas,
-        centroids, and the cells themselves on demand)."""
+        centroids, and the cells themselves on demand). Computed without holding the
+        interpreter; Ctrl-C stops it."""
         return self._tri.voronoi()
 
 

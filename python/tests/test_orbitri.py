@@ -55,7 +55,7 @@ def _freud_compare(box, n, seed, freud_misses_faces=False):
         pts[:, 2] = 0.0
     voro = freud.locality.Voronoi()
     voro.compute((box, pts))
-    ours = orbitri.periodic_voronoi(pts[:, :2] if box.is2D else pts, box)
+    ours = orbitri.periodic_voronoi(pts, box)  # freud's 2D points: N × 3 with z = 0
     np.testing.assert_allclose(ours.volumes, voro.volumes, rtol=1e-9)
     nl = voro.nlist
     theirs = {
@@ -181,9 +181,9 @@ def test_errors_are_value_errors_with_the_place():
     with pytest.raises(ValueError, match=r"\(N, 2\) or \(N, 3\)"):
         orbitri.PeriodicDelaunay(np.zeros((5, 4)), [1, 1, 1, 1])
     with pytest.raises(ValueError, match="lengths"):
-        orbitri.PeriodicDelaunay(np.zeros((5, 3)), [1, 1])
+        orbitri.PeriodicDelaunay(np.zeros((5, 3)), [1, 1, 1, 1])
     tri = orbitri.PeriodicDelaunay([[0.1, 0.2]], [1, 1])
-    with pytest.raises(ValueError, match="2 columns"):
+    with pytest.raises(ValueError, match="2 columns, or 3 whose last is 0"):
         tri.insert([[0.1, 0.2, 0.3]])
 
 

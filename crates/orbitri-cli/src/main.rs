@@ -243,6 +243,7 @@ where
         if let Some(b) = &bar {
             b.set_position(k as u64);
         }
+        std::ops::ControlFlow::Continue(())
     })?;
     let cost = Cost {
         seconds: start.elapsed().as_secs_f64(),

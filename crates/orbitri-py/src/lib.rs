@@ -1,20 +1,97 @@
 //! The Python extension `orbitri._orbitri`: the triangulation and its Voronoi cells for numpy
 //! arrays. The Python package (`python/orbitri`) parses boxes and documents the API; this
 //! module converts arrays (one copy of the input), releases the interpreter during
-//! construction, and turns errors into `ValueError` with the library's message.
+//! construction, insertion and the Voronoi cells, and turns errors into `ValueError` with the
+//! library's message.
+//!
+//! Threads: a triangulation is shared through a read–write lock (readers together, `insert`,
+//! `locate` and `try_one_sheet` alone). No thread ever blocks on the lock while attached to
+//! the interpreter (it waits detached, `RwLockExt`), so a holder that reattaches cannot
+//! deadlock.
+//!
+//! Ctrl-C: the construction and the Voronoi cells run detached, on the main thread on a
+//! helper thread while the main one runs the signal handlers every `POLL` (`interruptible`).
+//! A handler's exception (`KeyboardInterrupt`) is raised at once; the computation sees its
+//! stop flag at its next poll (the library's progress callback, `voronoi_cells_until`) and
+//! ends in the background.
+
+use std::ops::ControlFlow;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::{mpsc, Arc, Mutex, RwLock, RwLockReadGuard, RwLockWriteGuard};
+use std::time::Duration;
 
 use numpy::ndarray::{Array1, Array2, Array3, ArrayView2};
 use numpy::{AllowTypeChange, IntoPyArray, PyArray1, PyArray2, PyArrayLike2};
 use orbitri::periodic::Torus;
 use orbitri::{
-    CellMeasures, FlatTorus, PeriodicDelaunay, PeriodicDelaunay2, PeriodicDelaunay3, VoronoiCell,
+    BuildOptions, CellMeasures, FlatTorus, PeriodicDelaunay, PeriodicDelaunay2, PeriodicDelaunay3,
+    VoronoiCell,
 };
-use pyo3::exceptions::PyValueError;
+use pyo3::exceptions::{PyIndexError, PyOverflowError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
+use pyo3::sync::RwLockExt;
 use pyo3::types::PyDict;
 
 fn value_error(e: orbitri::Error) -> PyErr {
     PyValueError::new_err(e.to_string())
+}
+
+/// How often the main thread runs the signal handlers while a long computation runs.
+const POLL: Duration = Duration::from_millis(50);
+
+/// Inputs smaller than this (points, vertices) are computed on the calling thread: they end
+/// sooner than a helper thread would be worth.
+const SMALL: usize = 20_000;
+
+/// Runs `work` (of `size` points) without the interpreter and answers Ctrl-C.
+///
+/// On the main thread (the only one that receives signals), unless the input is small,
+/// `work` runs on a helper thread while this one waits detached and runs the signal handlers
+/// every `POLL`. Once a handler raises (`KeyboardInterrupt`), the call returns that
+/// exception at once: `work` sees `stop` raised at its next poll and ends in the background,
+/// its result dropped. Elsewhere `work` runs here, and `stop` is never raised.
+fn interruptible<T: Send + 'static>(
+    py: Python<'_>,
+    size: usize,
+    work: impl FnOnce(&AtomicBool) -> PyResult<T> + Send + 'static,
+) -> PyResult<T> {
+    let threading = py.import("threading")?;
+    let main = threading
+        .call_method0("main_thread")?
+        .is(&threading.call_method0("current_thread")?);
+    if !main || size < SMALL {
+        return py.detach(|| work(&AtomicBool::new(false)));
+    }
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = Arc::clone(&stop);
+    let (tx, rx) = mpsc::channel();
+    let worker = std::thread::Builder::new()
+        .name("orbitri".into())
+        // the main thread's size: the work would have run there
+        .stack_size(8 << 20)
+        .spawn(move || {
+            let _ = tx.send(work(&flag));
+        })
+        .map_err(|e| PyRuntimeError::new_err(format!("cannot start a thread: {e}")))?;
+    // a `Receiver` is not `Sync`: the lock (only ever taken here) lets the wait run detached
+    let rx = Mutex::new(rx);
+    loop {
+        let next = py.detach(|| rx.lock().expect("one waiter").recv_timeout(POLL));
+        match next {
+            Ok(result) => return result,
+            Err(mpsc::RecvTimeoutError::Timeout) => {
+                if let Err(e) = py.check_signals() {
+                    stop.store(true, Ordering::Relaxed);
+                    return Err(e);
+                }
+            }
+            // `work` panicked: raise its panic here
+            Err(mpsc::RecvTimeoutError::Disconnected) => match worker.join() {
+                Err(panic) => std::panic::resume_unwind(panic),
+                Ok(()) => unreachable!("the worker sends its result before it ends"),
+            },
+        }
+    }
 }
 
 /// The rows of an `(N, D)` array as points (the one copy of the input).
@@ -65,10 +142,34 @@ fn array2<T: numpy::Element>(
         .into_pyarray(py)
 }
 
-/// A periodic Delaunay triangulation (use `orbitri.PeriodicDelaunay`).
-#[pyclass(module = "orbitri._orbitri")]
+/// A periodic Delaunay triangulation (use `orbitri.PeriodicDelaunay`), shareable between
+/// threads.
+#[pyclass(module = "orbitri._orbitri", frozen)]
 struct Triangulation {
-    tri: Tri,
+    /// Shared with a computation that may outlive an interrupted call (`voronoi`).
+    tri: Arc<RwLock<Tri>>,
+    /// 2 or 3 (never changes: read without the lock).
+    dim: usize,
+    /// Counts the modifications of the cells (for the Python side's cache of `cells()`).
+    generation: AtomicU64,
+}
+
+fn poisoned<T>(_: T) -> PyErr {
+    PyRuntimeError::new_err(
+        "the triangulation is unusable: a call panicked while modifying it (please report)",
+    )
+}
+
+impl Triangulation {
+    /// Shared access; waits (detached) while another thread modifies the triangulation.
+    fn read(&self, py: Python<'_>) -> PyResult<RwLockReadGuard<'_, Tri>> {
+        self.tri.read_py_attached(py).map_err(poisoned)
+    }
+
+    /// Exclusive access; waits (detached) while other threads use the triangulation.
+    fn write(&self, py: Python<'_>) -> PyResult<RwLockWriteGuard<'_, Tri>> {
+        self.tri.write_py_attached(py).map_err(poisoned)
+    }
 }
 
 fn build<const D: usize, const N: usize>(
@@ -79,11 +180,49 @@ fn build<const D: usize, const N: usize>(
 where
     FlatTorus<D>: Torus<D, N>,
 {
-    py.detach(move || {
-        let torus = FlatTorus::<D>::triclinic(lattice)?;
-        PeriodicDelaunay::build(torus, &points)
+    interruptible(py, points.len(), move |stop| {
+        let torus = FlatTorus::<D>::triclinic(lattice).map_err(value_error)?;
+        PeriodicDelaunay::build_with(torus, &points, BuildOptions::default(), |_| {
+            if stop.load(Ordering::Relaxed) {
+                ControlFlow::Break(())
+            } else {
+                ControlFlow::Continue(())
+            }
+        })
+        .map_err(value_error)
     })
-    .map_err(value_error)
+}
+
+/// The first non-finite coordinate of row-major points of dimension `d`, as the library
+/// names it, with the row in the batch as the point.
+fn check_finite(flat: &[f64], d: usize) -> PyResult<()> {
+    match flat.iter().position(|v| !v.is_finite()) {
+        None => Ok(()),
+        Some(k) => Err(value_error(orbitri::Error::NonFiniteCoordinate {
+            index: k / d,
+            axis: k % d,
+            value: flat[k],
+        })),
+    }
+}
+
+/// Inserts row-major points of dimension `D` (all finite); their input ids.
+fn insert_all<const D: usize, const N: usize>(
+    t: &mut PeriodicDelaunay<D, N>,
+    flat: &[f64],
+) -> Vec<i64>
+where
+    FlatTorus<D>: Torus<D, N>,
+{
+    flat.chunks_exact(D)
+        .map(|q| {
+            let r = t
+                .insert(std::array::from_fn(|c| q[c]))
+                .expect("checked finite");
+            let (orbitri::Inserted::New(v) | orbitri::Inserted::Duplicate(v)) = r;
+            i64::from(t.input_of_vertex(v))
+        })
+        .collect()
 }
 
 fn simplices<const D: usize, const N: usize>(
@@ -141,104 +280,130 @@ impl Triangulation {
                 )))
             }
         };
-        Ok(Triangulation { tri })
+        Ok(Triangulation {
+            tri: Arc::new(RwLock::new(tri)),
+            dim: d,
+            generation: AtomicU64::new(0),
+        })
     }
 
     /// 2 or 3.
     #[getter]
     fn dimension(&self) -> usize {
-        with_tri!(&self.tri, t => t.space().lattice().vectors().len())
+        self.dim
+    }
+
+    /// Counts the modifications of the cells (`insert`, `try_one_sheet`).
+    #[getter]
+    fn generation(&self) -> u64 {
+        self.generation.load(Ordering::Acquire)
     }
 
     /// The lattice vectors (rows).
     #[getter]
-    fn lattice<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        with_tri!(&self.tri, t => {
+    fn lattice<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        Ok(with_tri!(&*self.read(py)?, t => {
             let m = t.space().lattice().vectors();
             array2(py, m.len(), m.len(), m.iter().flatten().copied().collect())
-        })
+        }))
     }
 
     /// The input points wrapped into the domain, in input order.
     #[getter]
-    fn points<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        let d = self.dimension();
-        with_tri!(&self.tri, t => {
+    fn points<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let d = self.dim;
+        Ok(with_tri!(&*self.read(py)?, t => {
             let n = t.number_of_input_points();
             let v: Vec<f64> = (0..n)
                 .flat_map(|i| t.point(t.vertex_of_input(i)))
                 .collect();
             array2(py, n, d, v)
-        })
+        }))
     }
 
     /// (simplices, offsets, neighbors) of every stored cell.
-    fn cells(&self, py: Python<'_>) -> (Py<PyAny>, Py<PyAny>, Py<PyAny>) {
-        with_tri!(&self.tri, t => simplices(py, t))
+    fn cells(&self, py: Python<'_>) -> PyResult<(Py<PyAny>, Py<PyAny>, Py<PyAny>)> {
+        Ok(with_tri!(&*self.read(py)?, t => simplices(py, t)))
     }
 
     #[getter]
-    fn sheets(&self) -> usize {
-        with_tri!(&self.tri, t => t.sheets())
+    fn sheets(&self, py: Python<'_>) -> PyResult<usize> {
+        Ok(with_tri!(&*self.read(py)?, t => t.sheets()))
     }
 
     #[getter]
-    fn is_one_sheeted(&self) -> bool {
-        with_tri!(&self.tri, t => t.is_one_sheeted())
+    fn is_one_sheeted(&self, py: Python<'_>) -> PyResult<bool> {
+        Ok(with_tri!(&*self.read(py)?, t => t.is_one_sheeted()))
+    }
+
+    /// Moves a triangulation still in a covering space to the 1-sheeted torus if its
+    /// projection is a simplicial complex; whether it is 1-sheeted.
+    fn try_one_sheet(&self, py: Python<'_>) -> PyResult<bool> {
+        let mut guard = self.write(py)?;
+        let tri = &mut *guard;
+        let one = py.detach(|| with_tri!(tri, t => t.try_one_sheet()));
+        self.generation.fetch_add(1, Ordering::AcqRel);
+        Ok(one)
+    }
+
+    /// Number of input points given so far.
+    #[getter]
+    fn number_of_input_points(&self, py: Python<'_>) -> PyResult<usize> {
+        Ok(with_tri!(&*self.read(py)?, t => t.number_of_input_points()))
     }
 
     /// For every input point, the input id of its first occurrence.
     #[getter]
-    fn duplicates<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<i64>> {
-        with_tri!(&self.tri, t => t.first_occurrences().into_iter().map(i64::from).collect::<Array1<i64>>().into_pyarray(py))
+    fn duplicates<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<i64>>> {
+        let first = with_tri!(&*self.read(py)?, t => t.first_occurrences());
+        Ok(first
+            .into_iter()
+            .map(i64::from)
+            .collect::<Array1<i64>>()
+            .into_pyarray(py))
     }
 
     #[getter]
-    fn number_of_duplicates(&self) -> usize {
-        with_tri!(&self.tri, t => t.duplicates())
+    fn number_of_duplicates(&self, py: Python<'_>) -> PyResult<usize> {
+        Ok(with_tri!(&*self.read(py)?, t => t.duplicates()))
     }
 
     #[getter]
-    fn number_of_wrapped(&self) -> usize {
-        with_tri!(&self.tri, t => t.wrapped())
+    fn number_of_wrapped(&self, py: Python<'_>) -> PyResult<usize> {
+        Ok(with_tri!(&*self.read(py)?, t => t.wrapped()))
     }
 
-    /// Inserts points; returns the input id each became or coincides with.
+    /// Inserts points, all or none: every coordinate is checked first (an error names the
+    /// row of `points` and the axis); returns the input id each became or coincides with.
     fn insert<'py>(
-        &mut self,
+        &self,
         py: Python<'py>,
         points: PyArrayLike2<'_, f64, AllowTypeChange>,
     ) -> PyResult<Bound<'py, PyArray1<i64>>> {
         let p = points.as_array();
-        let ids = with_tri!(&mut self.tri, t => {
-            let d = t.space().lattice().vectors().len();
-            if p.shape()[1] != d {
-                return Err(PyValueError::new_err(format!(
-                    "points must have {d} columns, not {}",
-                    p.shape()[1]
-                )));
-            }
-            let pts = rows(p);
-            let mut ids = Vec::with_capacity(pts.len());
-            for q in pts {
-                let r = t.insert(q).map_err(value_error)?;
-                let point = match r {
-                    orbitri::Inserted::New(v) | orbitri::Inserted::Duplicate(v) => v,
-                };
-                ids.push(i64::from(t.input_of_vertex(point)));
-            }
-            ids
-        });
+        let d = self.dim;
+        if p.shape()[1] != d {
+            return Err(PyValueError::new_err(format!(
+                "points must have {d} columns, not {}",
+                p.shape()[1]
+            )));
+        }
+        let flat: Vec<f64> = p.iter().copied().collect();
+        check_finite(&flat, d)?;
+        let mut guard = self.write(py)?;
+        let tri = &mut *guard;
+        let ids = py.detach(|| with_tri!(tri, t => insert_all(t, &flat)));
+        self.generation.fetch_add(1, Ordering::AcqRel);
         Ok(Array1::from(ids).into_pyarray(py))
     }
 
     /// (vertices, offsets, point offset) of the cell containing a point.
     fn locate(
-        &mut self,
+        &self,
         py: Python<'_>,
         point: Vec<f64>,
     ) -> PyResult<(Py<PyAny>, Py<PyAny>, Py<PyAny>)> {
-        with_tri!(&mut self.tri, t => {
+        with_tri!(&mut *self.write(py)?, t => {
             let d = t.space().lattice().vectors().len();
             if point.len() != d {
                 return Err(PyValueError::new_err(format!(
@@ -260,8 +425,8 @@ impl Triangulation {
     }
 
     /// (pairs E×2, shifts E×D, lengths E) of the Delaunay edges, each once.
-    fn edges(&self, py: Python<'_>) -> (Py<PyAny>, Py<PyAny>, Py<PyAny>) {
-        with_tri!(&self.tri, t => {
+    fn edges(&self, py: Python<'_>) -> PyResult<(Py<PyAny>, Py<PyAny>, Py<PyAny>)> {
+        Ok(with_tri!(&*self.read(py)?, t => {
             let e = t.delaunay_edges();
             let d = t.space().lattice().vectors().len();
             let ij: Vec<i64> = e.iter().flat_map(|x| [i64::from(x.i), i64::from(x.j)]).collect();
@@ -272,18 +437,36 @@ impl Triangulation {
                 array2(py, e.len(), d, s).into_any().unbind(),
                 l.into_pyarray(py).into_any().unbind(),
             )
-        })
+        }))
     }
 
-    /// (ids, shifts) of the Delaunay neighbours of input point `i`.
-    fn vertex_neighbors(&self, py: Python<'_>, i: usize) -> PyResult<(Py<PyAny>, Py<PyAny>)> {
-        with_tri!(&self.tri, t => {
-            if i >= t.number_of_input_points() {
-                return Err(PyValueError::new_err(format!(
-                    "point {i} does not exist ({} points)",
-                    t.number_of_input_points()
-                )));
-            }
+    /// (ids, shifts) of the Delaunay neighbours of input point `i`: any integer (Python's
+    /// or numpy's, not a float or a string), `0 <= i < number_of_input_points`.
+    fn vertex_neighbors(
+        &self,
+        py: Python<'_>,
+        i: &Bound<'_, PyAny>,
+    ) -> PyResult<(Py<PyAny>, Py<PyAny>)> {
+        let guard = self.read(py)?;
+        let n = with_tri!(&*guard, t => t.number_of_input_points());
+        let out_of_range = || {
+            PyIndexError::new_err(format!(
+                "point {} does not exist: the ids of the {n} input points are 0 to {}",
+                i.str().map_or_else(|_| "?".into(), |s| s.to_string()),
+                n as i64 - 1
+            ))
+        };
+        // `__index__`: a float or a string is a TypeError, a huge int out of range
+        let i = match i.extract::<i64>() {
+            Ok(i) => i,
+            Err(e) if e.is_instance_of::<PyOverflowError>(py) => return Err(out_of_range()),
+            Err(e) => return Err(e),
+        };
+        let i = usize::try_from(i)
+            .ok()
+            .filter(|&i| i < n)
+            .ok_or_else(out_of_range)?;
+        with_tri!(&*guard, t => {
             let nb = t.vertex_neighbors(i);
             let d = t.space().lattice().vectors().len();
             let ids: Vec<i64> = nb.iter().map(|x| i64::from(x.0)).collect();
@@ -295,14 +478,26 @@ impl Triangulation {
         })
     }
 
-    /// The Voronoi cells of the points (computed without holding the interpreter).
-    fn voronoi(&self, py: Python<'_>) -> Voronoi {
-        let cells = match &self.tri {
-            Tri::Two(t) => Cells::Two(py.detach(|| t.voronoi_cells()), t.first_occurrences()),
-            Tri::Three(t) => Cells::Three(py.detach(|| t.voronoi_cells()), t.first_occurrences()),
-        };
+    /// The Voronoi cells of the points (computed without holding the interpreter; Ctrl-C
+    /// stops them).
+    fn voronoi(&self, py: Python<'_>) -> PyResult<Voronoi> {
+        let vertices = with_tri!(&*self.read(py)?, t => t.number_of_vertices());
+        let shared = Arc::clone(&self.tri);
+        let cells = interruptible(py, vertices, move |stop| {
+            let interrupt = || stop.load(Ordering::Relaxed);
+            Ok(match &*shared.read().map_err(poisoned)? {
+                Tri::Two(t) => Cells::Two(
+                    t.voronoi_cells_until(&interrupt).map_err(value_error)?,
+                    t.first_occurrences(),
+                ),
+                Tri::Three(t) => Cells::Three(
+                    t.voronoi_cells_until(&interrupt).map_err(value_error)?,
+                    t.first_occurrences(),
+                ),
+            })
+        })?;
         let per_point = with_cells!(&cells, c, first => PerPoint::of(c, first));
-        Voronoi { cells, per_point }
+        Ok(Voronoi { cells, per_point })
     }
 }
 

@@ -17,8 +17,10 @@ fn main() {
         ..Default::default()
     };
     let tri =
-        PeriodicDelaunay3::build_with(FlatTorus3::cuboid([1.0; 3]).unwrap(), &pts, opts, |_| {})
-            .unwrap();
+        PeriodicDelaunay3::build_with(FlatTorus3::cuboid([1.0; 3]).unwrap(), &pts, opts, |_| {
+            std::ops::ControlFlow::Continue(())
+        })
+        .unwrap();
     let dt = t.elapsed().as_secs_f64();
     println!(
         "n={n} V={} C={} sheets={} dummies={} time={dt:.3}",

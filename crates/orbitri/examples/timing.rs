@@ -31,7 +31,7 @@ fn main() {
             dummy_threshold: thr,
             ..Default::default()
         },
-        |_| {},
+        |_| std::ops::ControlFlow::Continue(()),
     )
     .unwrap();
     println!(

@@ -43,6 +43,9 @@ pub enum Error {
         #[source]
         source: std::io::Error,
     },
+    /// The caller's progress or interrupt callback asked a long computation to stop.
+    #[error("interrupted")]
+    Interrupted,
 }
 
 /// The library's result type.

@@ -4,6 +4,7 @@
 //! `PeriodicDelaunay3` name the two dimensions.
 
 use std::collections::HashSet;
+use std::ops::ControlFlow;
 
 use crate::delaunay::{Engine, Inserted, Invalid};
 use crate::error::{Error, Result};
@@ -126,6 +127,14 @@ fn internal_point<const D: usize>(
         })
 }
 
+/// Reports progress `k` to the build's callback: `Err(Interrupted)` if it asks to stop.
+fn proceed(progress: &mut impl FnMut(usize) -> ControlFlow<()>, k: usize) -> Result<()> {
+    match progress(k) {
+        ControlFlow::Continue(()) => Ok(()),
+        ControlFlow::Break(()) => Err(Error::Interrupted),
+    }
+}
+
 impl<const D: usize, const N: usize> PeriodicDelaunay<D, N>
 where
     FlatTorus<D>: Torus<D, N>,
@@ -144,18 +153,38 @@ where
 
     /// Builds the triangulation of `points` (wrapped into the domain first).
     pub fn build(space: FlatTorus<D>, points: &[[f64; D]]) -> Result<Self> {
-        Self::build_with(space, points, BuildOptions::default(), |_| {})
+        Self::build_with(space, points, BuildOptions::default(), |_| {
+            ControlFlow::Continue(())
+        })
     }
 
     /// Bulk construction: spatial sort (BRIO + Hilbert); for large inputs start from the
     /// dummy point set in the 1-sheeted torus and remove the dummies at the end, otherwise
     /// (or if removing a dummy would break the criterion) insert into the covering space.
-    /// `progress` is called with the number of points inserted so far.
+    ///
+    /// `progress` is called with the number of points inserted so far: before the first,
+    /// every 4096 points and at the end. Returning [`ControlFlow::Break`] stops the
+    /// construction, which then returns [`Error::Interrupted`] (a cancellation hook: keep
+    /// the callback cheap, it runs between insertions).
+    ///
+    /// ```
+    /// use std::ops::ControlFlow;
+    /// use orbitri::{BuildOptions, Error, FlatTorus2, PeriodicDelaunay2};
+    /// let pts: Vec<[f64; 2]> = (0..10_000)
+    ///     .map(|i| [(i as f64 * 0.618034) % 1.0, (i as f64 * 0.414214) % 1.0])
+    ///     .collect();
+    /// let torus = FlatTorus2::cuboid([1.0, 1.0]).unwrap();
+    /// let stop_after_half = |k: usize| {
+    ///     if k >= 5_000 { ControlFlow::Break(()) } else { ControlFlow::Continue(()) }
+    /// };
+    /// let r = PeriodicDelaunay2::build_with(torus, &pts, BuildOptions::default(), stop_after_half);
+    /// assert!(matches!(r, Err(Error::Interrupted)));
+    /// ```
     pub fn build_with(
         space: FlatTorus<D>,
         points: &[[f64; D]],
         opts: BuildOptions,
-        progress: impl Fn(usize),
+        mut progress: impl FnMut(usize) -> ControlFlow<()>,
     ) -> Result<Self> {
         if points.is_empty() {
             return Err(Error::EmptyInput);
@@ -181,7 +210,7 @@ where
         tri.engine
             .reserve(points.len() + 128, points.len() * per_point / 4 + 4096);
         if points.len() >= opts.dummy_threshold
-            && tri.build_from_dummies(&wrapped_pts, &order, &progress)
+            && tri.build_from_dummies(&wrapped_pts, &order, &mut progress)?
         {
             tri.represent_first_occurrences(&wrapped_pts);
             return Ok(tri);
@@ -190,16 +219,16 @@ where
         tri.wrapped = wrapped;
         tri.input_point = vec![NONE; points.len()];
         for (k, &i) in order.iter().enumerate() {
-            tri.insert_wrapped(i as usize, wrapped_pts[i as usize]);
             if k % 4096 == 0 {
-                progress(k);
+                proceed(&mut progress, k)?;
             }
+            tri.insert_wrapped(i as usize, wrapped_pts[i as usize]);
         }
         if !tri.engine.is_one_sheeted() {
             tri.engine.try_one_sheet();
         }
         tri.represent_first_occurrences(&wrapped_pts);
-        progress(points.len());
+        proceed(&mut progress, points.len())?;
         Ok(tri)
     }
 
@@ -230,13 +259,14 @@ where
     }
 
     /// Dummy-point construction; false if it had to be abandoned (a point coincides with a
-    /// dummy, or the points alone do not satisfy the criterion).
+    /// dummy, or the points alone do not satisfy the criterion), `Err` if `progress` stopped
+    /// it.
     fn build_from_dummies(
         &mut self,
         pts: &[[f64; D]],
         order: &[u32],
-        progress: &impl Fn(usize),
-    ) -> bool {
+        progress: &mut impl FnMut(usize) -> ControlFlow<()>,
+    ) -> Result<bool> {
         let dummies = self.engine.space().dummy_points();
         let k = dummies.len() as u32;
         self.engine.points = dummies;
@@ -245,21 +275,21 @@ where
         // placeholders: point indices count the dummies until they are dropped
         self.point_input = vec![NONE; k as usize];
         for (n, &i) in order.iter().enumerate() {
+            if n % 4096 == 0 {
+                proceed(progress, n)?;
+            }
             match self.engine.insert(pts[i as usize]) {
                 Inserted::New(p) => {
                     self.input_point[i as usize] = p;
                     self.point_input.push(i);
                 }
-                Inserted::Duplicate(p) if p < k => return false,
+                Inserted::Duplicate(p) if p < k => return Ok(false),
                 Inserted::Duplicate(p) => self.record_duplicate(i as usize, p),
-            }
-            if n % 4096 == 0 {
-                progress(n);
             }
         }
         for d in 0..k {
             if self.engine.remove_vertex(d).is_err() {
-                return false;
+                return Ok(false);
             }
         }
         self.engine.drop_leading_points(k);
@@ -268,8 +298,8 @@ where
             *p -= k;
         }
         self.used_dummies = true;
-        progress(pts.len());
-        true
+        proceed(progress, pts.len())?;
+        Ok(true)
     }
 
     fn insert_wrapped(&mut self, i: usize, p: [f64; D]) -> Inserted {

@@ -10,6 +10,7 @@
 
 use rayon::prelude::*;
 
+use crate::error::{Error, Result};
 use crate::periodic::{PeriodicDelaunay, Torus};
 use crate::space::{FlatTorus, OrbitSpace};
 
@@ -147,21 +148,70 @@ where
         self.per_cell(|c| CellMeasures::from(&c))
     }
 
+    /// The Voronoi cells as [`Self::voronoi_cells`], stopping early with
+    /// [`Error::Interrupted`] once `interrupt` returns true. `interrupt` is polled from the
+    /// worker threads every 1024 cells (keep it cheap: an atomic load); the circumcenters
+    /// computed before the cells are not interruptible.
+    ///
+    /// ```
+    /// use orbitri::{Error, FlatTorus2, PeriodicDelaunay2};
+    /// let pts: Vec<[f64; 2]> = (0..5000)
+    ///     .map(|i| [(i as f64 * 0.618034) % 1.0, (i as f64 * 0.414214) % 1.0])
+    ///     .collect();
+    /// let tri = PeriodicDelaunay2::build(FlatTorus2::cuboid([1.0, 1.0]).unwrap(), &pts).unwrap();
+    /// assert_eq!(tri.voronoi_cells_until(&|| false).unwrap().len(), 5000);
+    /// assert!(matches!(tri.voronoi_cells_until(&|| true), Err(Error::Interrupted)));
+    /// ```
+    pub fn voronoi_cells_until(
+        &self,
+        interrupt: &(dyn Fn() -> bool + Sync),
+    ) -> Result<Vec<VoronoiCell<D>>> {
+        self.per_cell_until(|c| c, interrupt)
+    }
+
+    /// The measures as [`Self::voronoi_measures`], stopping early with
+    /// [`Error::Interrupted`] once `interrupt` returns true (polled as by
+    /// [`Self::voronoi_cells_until`]).
+    pub fn voronoi_measures_until(
+        &self,
+        interrupt: &(dyn Fn() -> bool + Sync),
+    ) -> Result<Vec<CellMeasures<D>>> {
+        self.per_cell_until(|c| CellMeasures::from(&c), interrupt)
+    }
+
     /// `f` of every cell, computed in parallel in point order (the spatially sorted
     /// insertion order: neighbouring points share triangulation cells in cache), returned in
     /// the order of first occurrence.
     fn per_cell<T: Send>(&self, f: impl Fn(VoronoiCell<D>) -> T + Sync) -> Vec<T> {
+        self.per_cell_until(f, &|| false)
+            .expect("never interrupted")
+    }
+
+    /// `per_cell`, polling `interrupt` every 1024 cells.
+    fn per_cell_until<T: Send>(
+        &self,
+        f: impl Fn(VoronoiCell<D>) -> T + Sync,
+        interrupt: &(dyn Fn() -> bool + Sync),
+    ) -> Result<Vec<T>> {
+        if interrupt() {
+            return Err(Error::Interrupted);
+        }
         let duals = self.duals();
         let mut out: Vec<Option<T>> = (0..self.number_of_vertices() as u32)
             .into_par_iter()
-            .map(|p| Some(f(self.cell_of_point(&duals, p))))
-            .collect();
+            .map(|p| {
+                if p % 1024 == 0 && interrupt() {
+                    return Err(Error::Interrupted);
+                }
+                Ok(Some(f(self.cell_of_point(&duals, p))))
+            })
+            .collect::<Result<_>>()?;
         let mut order: Vec<u32> = (0..out.len() as u32).collect();
         order.sort_unstable_by_key(|&p| self.input_of_vertex(p));
-        order
+        Ok(order
             .iter()
             .map(|&p| out[p as usize].take().expect("each point once"))
-            .collect()
+            .collect())
     }
 
     /// The Voronoi neighbour pairs with their shared face areas, each unordered pair of

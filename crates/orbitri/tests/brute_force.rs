@@ -7,7 +7,9 @@ use orbitri::sort::SplitMix;
 use orbitri::{BuildOptions, Copies, FlatTorus3, Inserted, PeriodicDelaunay3};
 
 fn build(space: FlatTorus3, pts: &[[f64; 3]], opts: BuildOptions) -> PeriodicDelaunay3 {
-    let tri = PeriodicDelaunay3::build_with(space, pts, opts, |_| {}).unwrap();
+    let tri =
+        PeriodicDelaunay3::build_with(space, pts, opts, |_| std::ops::ControlFlow::Continue(()))
+            .unwrap();
     tri.is_valid().unwrap();
     brute_force_check(&tri, pts);
     tri
@@ -89,8 +91,10 @@ fn insertion_order_does_not_matter() {
                 spatial_sort: trial != 1,
                 dummy_threshold: if trial == 2 { usize::MAX } else { 1000 },
             };
-            let tri =
-                PeriodicDelaunay3::build_with(space.clone(), &shuffled, opts, |_| {}).unwrap();
+            let tri = PeriodicDelaunay3::build_with(space.clone(), &shuffled, opts, |_| {
+                std::ops::ControlFlow::Continue(())
+            })
+            .unwrap();
             tri.is_valid().unwrap();
             let mapped: Vec<orbitri::CellView> = tri
                 .cells(Copies::Unique)

@@ -8,8 +8,10 @@ use orbitri::{BuildOptions, Copies, FlatTorus3, PeriodicDelaunay3};
 fn check(name: &str, opts: BuildOptions) {
     let (per, pts) = read_oracle_input(name);
     let ((sheets, v, c), expected) = read_dump(name);
-    let tri = PeriodicDelaunay3::build_with(FlatTorus3::cuboid(per).unwrap(), &pts, opts, |_| {})
-        .unwrap();
+    let tri = PeriodicDelaunay3::build_with(FlatTorus3::cuboid(per).unwrap(), &pts, opts, |_| {
+        std::ops::ControlFlow::Continue(())
+    })
+    .unwrap();
     tri.is_valid().unwrap();
     assert_eq!(
         (

@@ -42,7 +42,7 @@ proptest! {
             std::array::from_fn(|c| (0..3).map(|k| g[k] * m[k][c]).sum())
         }).collect();
         let opts = BuildOptions { dummy_threshold: if dummies { 0 } else { usize::MAX }, ..Default::default() };
-        let tri = PeriodicDelaunay3::build_with(s.clone(), &pts, opts, |_| {}).unwrap();
+        let tri = PeriodicDelaunay3::build_with(s.clone(), &pts, opts, |_| std::ops::ControlFlow::Continue(())).unwrap();
         prop_assert!(tri.is_valid().is_ok(), "{:?}", tri.is_valid());
         brute_force_check(&tri, &pts);
         prop_assert_eq!(tri.number_of_vertices() + tri.duplicates(), pts.len());
@@ -83,7 +83,7 @@ proptest! {
             std::array::from_fn(|c| (0..3).map(|k| f[k] * rows[k][c]).sum())
         }).collect();
         let opts = BuildOptions { dummy_threshold: if dummies { 0 } else { usize::MAX }, ..Default::default() };
-        let tri = PeriodicDelaunay3::build_with(s, &pts, opts, |_| {}).unwrap();
+        let tri = PeriodicDelaunay3::build_with(s, &pts, opts, |_| std::ops::ControlFlow::Continue(())).unwrap();
         prop_assert!(tri.is_valid().is_ok(), "{:?}", tri.is_valid());
         brute_force_check(&tri, &pts);
     }

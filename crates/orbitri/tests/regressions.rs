@@ -9,7 +9,9 @@ fn check(space: FlatTorus3, pts: &[[f64; 3]], dummy_threshold: usize) {
         dummy_threshold,
         ..Default::default()
     };
-    let tri = PeriodicDelaunay3::build_with(space, pts, opts, |_| {}).unwrap();
+    let tri =
+        PeriodicDelaunay3::build_with(space, pts, opts, |_| std::ops::ControlFlow::Continue(()))
+            .unwrap();
     tri.is_valid().unwrap();
     brute_force_check(&tri, pts);
 }
@@ -41,8 +43,10 @@ fn a_duplicate_keeps_the_coordinates_of_its_first_occurrence() {
     let at = |f: f64| -> [f64; 3] { std::array::from_fn(|c| f * rows[2][c]) };
     let pts = [at(1.0), at(0.0), at(-0.25)];
     let space = || FlatTorus3::triclinic(rows).unwrap();
-    let bulk =
-        PeriodicDelaunay3::build_with(space(), &pts, BuildOptions::default(), |_| {}).unwrap();
+    let bulk = PeriodicDelaunay3::build_with(space(), &pts, BuildOptions::default(), |_| {
+        std::ops::ControlFlow::Continue(())
+    })
+    .unwrap();
     bulk.is_valid().unwrap();
     brute_force_check(&bulk, &pts);
     let mut inc = PeriodicDelaunay3::new(space());

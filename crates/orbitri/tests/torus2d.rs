@@ -370,7 +370,10 @@ fn insertion_order_and_construction_path_do_not_matter() {
                 seed,
                 spatial_sort: sort,
             };
-            let tri = PeriodicDelaunay2::build_with(torus.clone(), &pts, opts, |_| {}).unwrap();
+            let tri = PeriodicDelaunay2::build_with(torus.clone(), &pts, opts, |_| {
+                std::ops::ControlFlow::Continue(())
+            })
+            .unwrap();
             assert_eq!(
                 canonical(&tri.cells(Copies::Unique)),
                 reference,

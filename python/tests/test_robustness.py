@@ -1,0 +1,237 @@
+"""The Python API under misuse and stress: one section per fix of the reliability issue."""
+
+import os
+import signal
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import orbitri
+
+import freud  # noqa: E402  (a test dependency: pip install .[test])
+
+
+def _canonical(simplices, offsets):
+    """The simplices as a set, each a sorted tuple of (vertex, *offset) translated to a
+    componentwise minimum offset of zero."""
+    o = offsets - offsets.min(axis=1, keepdims=True)
+    rows = np.concatenate([simplices[:, :, None], o], axis=2).tolist()
+    return {tuple(sorted(map(tuple, r))) for r in rows}
+
+
+def _check_fills_the_box(tri):
+    """Every stored simplex positively oriented, and (1-sheeted) their volumes fill the box."""
+    lifted = tri.points[tri.simplices] + tri.offsets @ tri.lattice
+    d = lifted[:, 1:] - lifted[:, :1]
+    vol = np.linalg.det(d) / (2 if tri.dimension == 2 else 6)
+    assert (vol > 0).all()
+    box = abs(np.linalg.det(tri.lattice))
+    assert abs(vol.sum() - tri.sheets * box) <= 1e-9 * box
+
+
+# --- freud's 2D convention --------------------------------------------------------------
+
+
+def test_freud_2d_points_have_a_zero_third_column():
+    rng = np.random.default_rng(13)
+    xy = rng.random((300, 2)) * [1.5, 1.0]
+    xyz = np.column_stack([xy, np.zeros(len(xy))])
+    want = orbitri.PeriodicDelaunay(xy, [1.5, 1.0])
+    tilted = np.array([[1.5, 0.0], [0.25, 1.0]])
+    for box in (
+        [1.5, 1.0],
+        np.array([[1.5, 0.0], [0.0, 1.0]]),
+        freud.box.Box(1.5, 1.0, is2D=True),
+        freud.box.Box.from_box([1.5, 1.0]),
+    ):
+        tri = orbitri.PeriodicDelaunay(xyz, box)
+        assert tri.dimension == 2 and tri.points.shape == (300, 2)
+        assert _canonical(tri.simplices, tri.offsets) == _canonical(want.simplices, want.offsets)
+    # tilted: a 2 × 2 matrix, or freud's box with xy (freud's tilt: b = (xy·Ly, Ly))
+    for box in (tilted, freud.box.Box(1.5, 1.0, xy=0.25, is2D=True)):
+        vor = orbitri.periodic_voronoi(xyz, box)
+        assert len(vor) == 300 and abs(vor.volumes.sum() - 1.5) < 1e-12
+    # insert and locate take them too
+    ids = tri.insert([[0.2, 0.3, 0.0]])
+    assert ids.tolist() == [300]
+    verts, _, _ = tri.locate([0.2, 0.3, 0.0])
+    assert 300 in verts.tolist()
+
+
+def test_freud_2d_points_off_the_plane_and_mixed_dimensions_are_errors():
+    rng = np.random.default_rng(14)
+    xyz = np.column_stack([rng.random((10, 2)), np.zeros(10)])
+    xyz[7, 2] = 0.5
+    for box in ([1.0, 1.0], np.eye(2), freud.box.Box.square(1.0)):
+        with pytest.raises(ValueError, match=r"2D points must have 2 columns, or 3 whose last is 0.*point 7 has z = 0.5"):
+            orbitri.PeriodicDelaunay(xyz, box)
+    tri = orbitri.PeriodicDelaunay(xyz[:5], [1.0, 1.0])
+    with pytest.raises(ValueError, match="point 2 has z = 0.5"):
+        tri.insert(xyz[5:])
+    assert len(tri.points) == 5
+    # a 3D box for 2D points: no silent cut to the first two axes
+    xy = rng.random((10, 2))
+    for box in (freud.box.Box.cube(1.0), np.eye(3), [1.0, 1.0, 1.0, 0.0, 0.0, 0.0]):
+        with pytest.raises(ValueError, match="a 3D box for 2D points"):
+            orbitri.PeriodicDelaunay(xy, box)
+    with pytest.raises(ValueError, match="a 2D box for 3D points"):
+        orbitri.lattice_matrix(freud.box.Box.square(1.0), 3)
+    # three numbers are read by the points: [Lx, Ly, Lz] in 3D, [Lx, Ly, xy] in 2D
+    assert orbitri.PeriodicDelaunay(xy, [1.0, 1.0, 0.25]).lattice.tolist() == [[1.0, 0.0], [0.25, 1.0]]
+
+
+# --- threads ----------------------------------------------------------------------------
+
+
+def test_one_triangulation_shared_by_threads():
+    rng = np.random.default_rng(15)
+    tri = orbitri.PeriodicDelaunay(rng.random((3000, 3)), [1.0, 1.0, 1.0])
+    batches = [rng.random((400, 3)) for _ in range(12)]
+    errors = []
+    start = threading.Barrier(4)
+
+    def guarded(work):
+        def run():
+            try:
+                start.wait()
+                work()
+            except BaseException as e:  # noqa: BLE001 (reported below)
+                errors.append(e)
+
+        return run
+
+    def writer(k):
+        for b in batches[k::2]:
+            ids = tri.insert(b)
+            assert len(ids) == len(b)
+
+    def reader():
+        for _ in range(6):
+            vor = tri.voronoi()
+            assert abs(vor.volumes.sum() - 1.0) < 1e-9
+            n = len(tri.points)
+            assert len(tri.simplices) == len(tri.offsets)
+            tri.vertex_neighbors(n - 1)
+            tri.locate([0.5, 0.5, 0.5])
+
+    threads = [threading.Thread(target=guarded(f)) for f in (lambda: writer(0), lambda: writer(1), reader, reader)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert errors == []
+    assert tri.number_of_input_points == 3000 + 12 * 400
+    _check_fills_the_box(tri)
+    # the same triangulation as the bulk build of the points in their input order
+    bulk = orbitri.PeriodicDelaunay(tri.points, [1.0, 1.0, 1.0])
+    assert _canonical(tri.simplices, tri.offsets) == _canonical(bulk.simplices, bulk.offsets)
+
+
+# --- insert is all or nothing ---------------------------------------------------------
+
+
+def test_insert_checks_every_point_before_inserting_any():
+    rng = np.random.default_rng(11)
+    tri = orbitri.PeriodicDelaunay(rng.random((20, 2)), [1.0, 1.0])
+    cells = _canonical(tri.simplices, tri.offsets)
+    # the error names the row of the batch (not the input id it would have had: 22)
+    with pytest.raises(ValueError, match=r"^point 2: coordinate 1 is NaN, not a finite number$"):
+        tri.insert([[0.1, 0.2], [0.3, 0.4], [0.5, np.nan]])
+    with pytest.raises(ValueError, match=r"^point 1: coordinate 0 is -inf"):
+        tri.insert(np.array([[0.1, 0.2], [-np.inf, 0.4]]))
+    assert tri.number_of_input_points == 20 and len(tri.points) == 20
+    assert _canonical(tri.simplices, tri.offsets) == cells
+    assert tri.insert([[0.1, 0.2], [0.3, 0.4]]).tolist() == [20, 21]
+
+
+# --- vertex_neighbors takes integer ids -------------------------------------------------
+
+
+def test_vertex_neighbors_takes_integers_in_range():
+    rng = np.random.default_rng(12)
+    tri = orbitri.PeriodicDelaunay(rng.random((50, 3)), [1.0, 1.0, 1.0])
+    ids, shifts = tri.vertex_neighbors(3)
+    for same in (np.int64(3), np.int32(3), np.uint8(3)):
+        i2, s2 = tri.vertex_neighbors(same)
+        np.testing.assert_array_equal(i2, ids)
+        np.testing.assert_array_equal(s2, shifts)
+    for bad in (-1, 50, 2**70, np.int64(-5)):
+        with pytest.raises(IndexError, match=rf"point {bad} does not exist: the ids of the 50 input points are 0 to 49"):
+            tri.vertex_neighbors(bad)
+    for bad in (1.5, 3.0, np.float64(3.0), "3", None):
+        with pytest.raises(TypeError):
+            tri.vertex_neighbors(bad)
+
+
+# --- try_one_sheet after incremental insertion -------------------------------------------
+
+
+def test_try_one_sheet_brings_clustered_batches_to_the_bulk_result():
+    # 2D clustered points: 8 clusters of 30 points (σ = 0.03) in a unit square, inserted
+    # in 4 batches of about 60 after a first point; the bulk build of the same points ends
+    # in the torus (1 sheet), the incremental one stays in the 4-sheeted covering
+    rng = np.random.default_rng(0)
+    centres = rng.random((8, 2))
+    pts = (centres[:, None, :] + 0.03 * rng.standard_normal((8, 30, 2))).reshape(-1, 2) % 1.0
+    rng.shuffle(pts)
+    bulk = orbitri.PeriodicDelaunay(pts, [1.0, 1.0])
+    assert bulk.sheets == 1
+    tri = orbitri.PeriodicDelaunay(pts[:1], [1.0, 1.0])
+    for batch in np.array_split(pts[1:], 4):
+        tri.insert(batch)
+    assert tri.sheets == 4 and not tri.is_one_sheeted
+    _check_fills_the_box(tri)
+    assert tri.try_one_sheet() is True
+    assert tri.sheets == 1 and tri.is_one_sheeted
+    _check_fills_the_box(tri)
+    # the same Delaunay triangulation as the bulk build's (the points are in general
+    # position: it is unique), with the same input ids
+    np.testing.assert_array_equal(tri.points, bulk.points)
+    assert len(tri.simplices) == len(bulk.simplices)
+    assert _canonical(tri.simplices, tri.offsets) == _canonical(bulk.simplices, bulk.offsets)
+    # and it stays correct after more insertions
+    tri.insert(rng.random((30, 2)))
+    _check_fills_the_box(tri)
+
+
+# --- Ctrl-C -----------------------------------------------------------------------------
+
+
+def _latency_of_ctrl_c(call, delay=0.3):
+    """Sends SIGINT to this process `delay` seconds into `call` (which must take longer);
+    returns the seconds from the signal to the KeyboardInterrupt."""
+    fired = []
+
+    def fire():
+        fired.append(time.perf_counter())
+        os.kill(os.getpid(), signal.SIGINT)
+
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    timer = threading.Timer(delay, fire)
+    try:
+        timer.start()
+        with pytest.raises(KeyboardInterrupt):
+            call()
+        return time.perf_counter() - fired[0]
+    finally:
+        timer.cancel()
+        timer.join()
+        signal.signal(signal.SIGINT, previous)
+
+
+def test_ctrl_c_stops_the_construction():
+    pts = np.random.default_rng(16).random((1_000_000, 3))
+    latency = _latency_of_ctrl_c(lambda: orbitri.PeriodicDelaunay(pts, [1.0, 1.0, 1.0]))
+    assert latency < 1.0, f"KeyboardInterrupt {latency:.2f} s after the signal"
+
+
+def test_ctrl_c_stops_the_voronoi_cells():
+    pts = np.random.default_rng(17).random((200_000, 3))
+    tri = orbitri.PeriodicDelaunay(pts, [1.0, 1.0, 1.0])
+    latency = _latency_of_ctrl_c(tri.voronoi)
+    assert latency < 1.0, f"KeyboardInterrupt {latency:.2f} s after the signal"
+    # the triangulation is untouched (an insertion waits for the abandoned computation)
+    assert tri.insert([[0.5, 0.5, 0.5]]).tolist() == [200_000]
+    assert tri.number_of_input_points == 200_001
