@@ -133,7 +133,8 @@ where
     /// It computes the circumcenters and cospherical classes of the whole triangulation
     /// first: for many cells, call [`Self::voronoi_cells`] once.
     pub fn voronoi_cell(&self, i: usize) -> VoronoiCell<D> {
-        self.cell_of_point(&self.duals(), self.vertex_of_input(i))
+        let duals = self.duals(&|| false).expect("never interrupted");
+        self.cell_of_point(&duals, self.vertex_of_input(i))
     }
 
     /// The Voronoi cells of the distinct points, in the order of their first occurrence
@@ -150,8 +151,8 @@ where
 
     /// The Voronoi cells as [`Self::voronoi_cells`], stopping early with
     /// [`Error::Interrupted`] once `interrupt` returns true. `interrupt` is polled from the
-    /// worker threads every 1024 cells (keep it cheap: an atomic load); the circumcenters
-    /// computed before the cells are not interruptible.
+    /// worker threads every 1024 cells (keep it cheap: an atomic load), also while the
+    /// circumcenters are computed.
     ///
     /// ```
     /// use orbitri::{Error, FlatTorus2, PeriodicDelaunay2};
@@ -196,7 +197,7 @@ where
         if interrupt() {
             return Err(Error::Interrupted);
         }
-        let duals = self.duals();
+        let duals = self.duals(interrupt)?;
         let mut out: Vec<Option<T>> = (0..self.number_of_vertices() as u32)
             .into_par_iter()
             .map(|p| {
@@ -220,18 +221,28 @@ where
         neighbor_pairs(&self.voronoi_cells())
     }
 
-    fn duals(&self) -> Duals<D> {
+    /// The shared duals, polling `interrupt` every 1024 cells.
+    fn duals(&self, interrupt: &(dyn Fn() -> bool + Sync)) -> Result<Duals<D>> {
         let e = self.engine();
         let torus = self.space();
         let ids: Vec<u32> = e.cell_ids().collect();
         let slots = ids.iter().max().map_or(0, |&m| m as usize + 1);
         let computed: Vec<[f64; D]> = ids
             .par_iter()
-            .map(|&c| torus.circumcenter(&e.lifted_cell(c)))
-            .collect();
+            .enumerate()
+            .map(|(k, &c)| {
+                if k % 1024 == 0 && interrupt() {
+                    return Err(Error::Interrupted);
+                }
+                Ok(torus.circumcenter(&e.lifted_cell(c)))
+            })
+            .collect::<Result<_>>()?;
         let mut center = vec![[0.0; D]; slots];
         for (k, &c) in ids.iter().enumerate() {
             center[c as usize] = computed[k];
+        }
+        if interrupt() {
+            return Err(Error::Interrupted);
         }
         // adjacent cells with one circumsphere: decided exactly, each facet once
         let merges: Vec<(u32, u32)> = ids
@@ -282,12 +293,12 @@ where
                 fill[v as usize] += 1;
             }
         }
-        Duals {
+        Ok(Duals {
             center,
             class,
             start,
             incident,
-        }
+        })
     }
 
     /// The cell of point index `p`, from the cells around one of its vertices.
