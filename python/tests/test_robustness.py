@@ -235,3 +235,33 @@ def test_ctrl_c_stops_the_voronoi_cells():
     # the triangulation is untouched (an insertion waits for the abandoned computation)
     assert tri.insert([[0.5, 0.5, 0.5]]).tolist() == [200_000]
     assert tri.number_of_input_points == 200_001
+
+
+def test_every_scale_gives_the_same_simplices_and_scaled_volumes():
+    rng = np.random.default_rng(4)
+    pts = np.floor(rng.random((300, 3)) * 2**20) / 2**20
+    base = orbitri.PeriodicDelaunay(pts, [1.0, 1.0, 1.0])
+    for k in (-1000, -100, 100, 1000):
+        s = 2.0**k
+        tri = orbitri.PeriodicDelaunay(pts * s, [s, s, s])
+        assert np.array_equal(tri.simplices, base.simplices)
+        assert np.array_equal(tri.offsets, base.offsets)
+        if abs(k) <= 100:
+            vol = tri.voronoi().volumes
+            assert np.array_equal(vol, base.voronoi().volumes * s**3)
+    # a box whose volume no double holds: the triangulation works, its volumes are an error
+    big = orbitri.PeriodicDelaunay(pts * 1e110, [1e110] * 3)
+    assert big.sheets == 1
+    with pytest.raises(ValueError, match="outside the range of doubles"):
+        big.voronoi()
+
+
+def test_voronoi_of_nearly_coincident_points_is_finite_and_sums():
+    rng = np.random.default_rng(5)
+    pts = rng.random((100, 3))
+    shifted = pts[:20] + 1.0  # unwrapped MD coordinates: near-duplicates after wrapping
+    ulp = np.nextafter(pts[20:30], 2.0)
+    vor = orbitri.periodic_voronoi(np.vstack([pts, shifted, ulp]), [1.0, 1.0, 1.0])
+    assert np.all(np.isfinite(vor.volumes)) and np.all(vor.volumes >= 0)
+    first = np.unique(orbitri.PeriodicDelaunay(np.vstack([pts, shifted, ulp]), [1.0] * 3).duplicates)
+    assert abs(vor.volumes[first].sum() - 1.0) < 1e-12

@@ -481,7 +481,10 @@ impl Triangulation {
     /// The Voronoi cells of the points (computed without holding the interpreter; Ctrl-C
     /// stops them).
     fn voronoi(&self, py: Python<'_>) -> PyResult<Voronoi> {
-        let vertices = with_tri!(&*self.read(py)?, t => t.number_of_vertices());
+        let vertices = with_tri!(&*self.read(py)?, t => {
+            t.space().lattice().check_volume_representable().map_err(value_error)?;
+            t.number_of_vertices()
+        });
         let shared = Arc::clone(&self.tri);
         let cells = interruptible(py, vertices, move |stop| {
             let interrupt = || stop.load(Ordering::Relaxed);
