@@ -63,10 +63,14 @@ impl Page<'_> {
         self.lattice.cartesian(&f)
     }
 
-    /// A polyline or point, with its extent in fractional coordinates.
-    fn shape(&self, pts: Vec<[f64; 2]>) -> Shape {
+    /// A polyline or point, with its extent in fractional coordinates. A shape with a
+    /// non-finite coordinate is left out (empty, at no translation): no `NaN` in the SVG.
+    fn shape(&self, mut pts: Vec<[f64; 2]>) -> Shape {
         let mut fmin = [f64::INFINITY; 2];
         let mut fmax = [f64::NEG_INFINITY; 2];
+        if !pts.as_flattened().iter().all(|x| x.is_finite()) {
+            pts.clear();
+        }
         for p in &pts {
             let f = self.lattice.fractional(p);
             for c in 0..2 {
@@ -104,6 +108,29 @@ impl Page<'_> {
             }
         }
         d
+    }
+}
+
+#[cfg(test)]
+#[test]
+fn a_shape_with_a_non_finite_coordinate_is_not_drawn() {
+    let lattice = Lattice::new([[1.0, 0.0], [0.0, 1.0]]).unwrap();
+    let page = Page {
+        lo: -1.0,
+        hi: 2.0,
+        lattice: &lattice,
+        origin: [0.0; 2],
+        top: 0.0,
+        scale: 100.0,
+    };
+    let good = page.shape(vec![[0.1, 0.2], [0.3, 0.4]]);
+    assert_eq!(page.translations(&good).count(), 9);
+    for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+        let s = page.shape(vec![[0.1, 0.2], [bad, 0.4], [0.5, 0.6]]);
+        assert_eq!(page.translations(&s).count(), 0);
+        let d = page.path(&[s, page.shape(vec![[0.1, 0.2], [0.3, 0.4]])]);
+        assert!(!d.contains("NaN") && !d.contains("inf"), "{d}");
+        assert_eq!(d, page.path(&[page.shape(vec![[0.1, 0.2], [0.3, 0.4]])]));
     }
 }
 
