@@ -2,6 +2,7 @@
 
 mod rss;
 
+use std::ffi::OsString;
 use std::io::{BufWriter, IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -75,10 +76,10 @@ enum Command {
         #[arg(short = 'o', long)]
         output: PathBuf,
         /// Copies of the domain per lattice direction
-        #[arg(long, default_value_t = 3)]
+        #[arg(long, default_value_t = 3, allow_hyphen_values = true)]
         copies: u32,
         /// Picture width in pixels
-        #[arg(long, default_value_t = 800.0)]
+        #[arg(long, default_value_t = 800.0, allow_hyphen_values = true)]
         width: f64,
         /// Leave out the Voronoi diagram
         #[arg(long)]
@@ -116,11 +117,11 @@ enum Command {
 #[group(required = true, multiple = false)]
 struct Domain {
     /// Box lengths: the domain is [0,LX) × [0,LY) × [0,LZ), or [0,LX) × [0,LY) in 2D
-    #[arg(long = "box", num_args = 2..=3, value_names = ["LX", "LY", "LZ"], allow_negative_numbers = true)]
+    #[arg(long = "box", num_args = 2..=3, value_names = ["LX", "LY", "LZ"], value_parser = number, allow_negative_numbers = true)]
     box_lengths: Option<Vec<f64>>,
     /// Lattice vectors (rows): AX AY AZ BX BY BZ CX CY CZ in 3D, AX AY BX BY in 2D; the
     /// domain is {f·M : f ∈ [0,1)^D}
-    #[arg(long, num_args = 4..=9, value_names = ["AX", "AY", "..."], allow_negative_numbers = true)]
+    #[arg(long, num_args = 4..=9, value_names = ["AX", "AY", "..."], value_parser = number, allow_negative_numbers = true)]
     lattice: Option<Vec<f64>>,
 }
 
@@ -569,8 +570,53 @@ fn generate(n: usize, seed: u64, dim: u8, output: Option<PathBuf>) -> Result<(),
     })
 }
 
+/// Marks the negative numbers that follow `--box` or `--lattice` (as many as
+/// `str::parse::<f64>` reads, up to the most the option takes) as values, with a leading
+/// blank that [`number`] drops.
+///
+/// clap reads a token that starts with `-` as a flag unless it is a plain negative number
+/// (`-2`, `-2.5`, `-2e5`), so `-2e-301`, `-.5` or `-inf` were unknown flags; and
+/// `allow_hyphen_values` would also take the `-o` of `--box 1 1 -o out` for a third length,
+/// as clap stops only at the most values an option takes.
+fn mark_negative_numbers(args: impl IntoIterator<Item = OsString>) -> Vec<OsString> {
+    let mut out = Vec::new();
+    let mut args = args.into_iter().peekable();
+    while let Some(arg) = args.next() {
+        let most = match arg.to_str() {
+            Some("--box") => 3,
+            Some("--lattice") => 9,
+            Some("--") => {
+                out.push(arg);
+                out.extend(args);
+                break;
+            }
+            _ => 0,
+        };
+        out.push(arg);
+        for _ in 0..most {
+            let Some(v) = args.next_if(|a| a.to_str().is_some_and(|v| v.parse::<f64>().is_ok()))
+            else {
+                break;
+            };
+            out.push(match v.to_str() {
+                Some(n) if n.starts_with('-') => format!(" {n}").into(),
+                _ => v,
+            });
+        }
+    }
+    out
+}
+
+/// A number as `str::parse::<f64>` reads it (after the blank of [`mark_negative_numbers`]).
+fn number(s: &str) -> Result<f64, String> {
+    s.strip_prefix(' ')
+        .unwrap_or(s)
+        .parse()
+        .map_err(|e: std::num::ParseFloatError| e.to_string())
+}
+
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = Cli::parse_from(mark_negative_numbers(std::env::args_os()));
     let result = match cli.command {
         Command::Triangulate { input, domain, out } => triangulate(input, domain, out),
         Command::Demo { points, seed } => demo(points, seed),
