@@ -75,10 +75,12 @@ enum Command {
         /// Output file: .svg or .png
         #[arg(short = 'o', long)]
         output: PathBuf,
-        /// Copies of the domain per lattice direction
+        /// Copies of the domain per lattice direction: at most 50, and at most 2000000 points
+        /// drawn (copies² × points)
         #[arg(long, default_value_t = 3, allow_hyphen_values = true)]
         copies: u32,
-        /// Picture width in pixels
+        /// Picture width in pixels, 1 to 8192 (one rule for SVG and PNG); the height, from
+        /// the domain's shape, must be at most 8192 too
         #[arg(long, default_value_t = 800.0, allow_hyphen_values = true)]
         width: f64,
         /// Leave out the Voronoi diagram
@@ -408,9 +410,25 @@ fn draw(input: PathBuf, domain: Domain, output: PathBuf, opts: SvgOptions) -> Re
         ));
     };
     let pts: Vec<[f64; 2]> = orbitri::io::read_points(&input)?;
+    opts.validate(pts.len()).map_err(option_error)?;
     let (tri, _): (PeriodicDelaunay2, _) = build(space, &pts)?;
     let mut svg = Vec::new();
-    orbitri::io::write_svg(&mut svg, &tri, &opts).expect("writing to memory");
+    orbitri::io::write_svg(&mut svg, &tri, &opts).map_err(|e| {
+        // writing to memory fails only on options out of range (a picture too high)
+        match e
+            .get_ref()
+            .and_then(|inner| inner.downcast_ref::<orbitri::Error>())
+        {
+            Some(orbitri::Error::InvalidOption { .. }) => {
+                let inner = e.into_inner().expect("checked").downcast();
+                option_error(*inner.expect("checked"))
+            }
+            _ => CliError::Write {
+                path: output.clone(),
+                source: e,
+            },
+        }
+    })?;
     let png = output
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("png"));
@@ -426,6 +444,18 @@ fn draw(input: PathBuf, domain: Domain, output: PathBuf, opts: SvgOptions) -> Re
         path: output,
         source,
     })
+}
+
+/// An option out of range, named as the flag the user typed.
+fn option_error(e: orbitri::Error) -> CliError {
+    match e {
+        orbitri::Error::InvalidOption {
+            option,
+            value,
+            limit,
+        } => CliError::Usage(format!("--{option} {value} is out of range: {limit}")),
+        e => e.into(),
+    }
 }
 
 /// Rasterizes our SVG (no text, no images) with resvg.

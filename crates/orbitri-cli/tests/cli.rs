@@ -328,6 +328,59 @@ fn numbers_are_read_as_rust_reads_them() {
 }
 
 #[test]
+fn draw_limits_name_the_flag_the_value_and_the_limit() {
+    let dir = tempfile::tempdir().unwrap();
+    let pts = dir.path().join("p2.txt");
+    orbitri(&[
+        "generate",
+        "3000",
+        "--dim",
+        "2",
+        "-o",
+        pts.to_str().unwrap(),
+    ]);
+    let one = write(dir.path(), "one.txt", "0.5 0.5\n");
+    let png = dir.path().join("t.png");
+    for (input, args, msg) in [
+        (&pts, "--box 1 1 --width 100000", "--width 100000 is out of range: a picture is 1 to 8192 pixels wide"),
+        (&pts, "--box 1 1 --width -1e-3", "--width -0.001 is out of range"),
+        (&pts, "--box 1 1 --width nan", "--width NaN is out of range"),
+        (&pts, "--box 1 1 --copies 1000", "--copies 1000 is out of range: at most 50 per lattice direction"),
+        (&one, "--box 1 1 --copies 51", "--copies 51 is out of range"),
+        (&pts, "--box 1 1 --copies 30", "--copies 30 is out of range: 30² copies of 3000 points make 2700000 points to draw, more than 2000000"),
+        (&one, "--box 1 9 --width 3000", "--width 3000 is out of range: the picture would be 20647 pixels high"),
+    ] {
+        let mut a = vec!["draw", input.to_str().unwrap(), "-o", png.to_str().unwrap()];
+        a.extend(args.split(' '));
+        let o = orbitri(&a);
+        assert_eq!(o.status.code(), Some(2), "{args}");
+        assert!(stderr(&o).contains(msg), "{args}: {}", stderr(&o));
+        assert!(!png.exists());
+    }
+    // at the limits
+    let svg = dir.path().join("t.svg");
+    for (input, args) in [(&one, "--copies 50"), (&pts, "--copies 25 --width 8192")] {
+        let mut a = vec![
+            "draw",
+            input.to_str().unwrap(),
+            "--box",
+            "1",
+            "1",
+            "-o",
+            svg.to_str().unwrap(),
+        ];
+        a.extend(args.split(' '));
+        let o = orbitri(&a);
+        assert!(o.status.success(), "{args}: {}", stderr(&o));
+    }
+    let help = String::from_utf8(orbitri(&["draw", "--help"]).stdout).unwrap();
+    assert!(
+        help.contains("at most 50") && help.contains("1 to 8192"),
+        "{help}"
+    );
+}
+
+#[test]
 fn generate_reproduces_the_anchor_points() {
     let o = orbitri(&["generate", "2", "--seed", "1"]);
     let text = String::from_utf8(o.stdout.clone()).unwrap();
