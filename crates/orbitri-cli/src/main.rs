@@ -2,6 +2,7 @@
 
 mod rss;
 
+use std::ffi::OsString;
 use std::io::{BufWriter, IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -74,11 +75,13 @@ enum Command {
         /// Output file: .svg or .png
         #[arg(short = 'o', long)]
         output: PathBuf,
-        /// Copies of the domain per lattice direction
-        #[arg(long, default_value_t = 3)]
+        /// Copies of the domain per lattice direction: at most 50, and at most 2000000 points
+        /// drawn (copies² × points)
+        #[arg(long, default_value_t = 3, allow_hyphen_values = true)]
         copies: u32,
-        /// Picture width in pixels
-        #[arg(long, default_value_t = 800.0)]
+        /// Picture width in pixels, 1 to 8192 (one rule for SVG and PNG); the height, from
+        /// the domain's shape, must be at most 8192 too
+        #[arg(long, default_value_t = 800.0, allow_hyphen_values = true)]
         width: f64,
         /// Leave out the Voronoi diagram
         #[arg(long)]
@@ -116,11 +119,11 @@ enum Command {
 #[group(required = true, multiple = false)]
 struct Domain {
     /// Box lengths: the domain is [0,LX) × [0,LY) × [0,LZ), or [0,LX) × [0,LY) in 2D
-    #[arg(long = "box", num_args = 2..=3, value_names = ["LX", "LY", "LZ"], allow_negative_numbers = true)]
+    #[arg(long = "box", num_args = 2..=3, value_names = ["LX", "LY", "LZ"], value_parser = number, allow_negative_numbers = true)]
     box_lengths: Option<Vec<f64>>,
     /// Lattice vectors (rows): AX AY AZ BX BY BZ CX CY CZ in 3D, AX AY BX BY in 2D; the
     /// domain is {f·M : f ∈ [0,1)^D}
-    #[arg(long, num_args = 4..=9, value_names = ["AX", "AY", "..."], allow_negative_numbers = true)]
+    #[arg(long, num_args = 4..=9, value_names = ["AX", "AY", "..."], value_parser = number, allow_negative_numbers = true)]
     lattice: Option<Vec<f64>>,
 }
 
@@ -409,9 +412,25 @@ fn draw(input: PathBuf, domain: Domain, output: PathBuf, opts: SvgOptions) -> Re
         ));
     };
     let pts: Vec<[f64; 2]> = orbitri::io::read_points(&input)?;
+    opts.validate(pts.len()).map_err(option_error)?;
     let (tri, _): (PeriodicDelaunay2, _) = build(space, &pts)?;
     let mut svg = Vec::new();
-    orbitri::io::write_svg(&mut svg, &tri, &opts).expect("writing to memory");
+    orbitri::io::write_svg(&mut svg, &tri, &opts).map_err(|e| {
+        // writing to memory fails only on options out of range (a picture too high)
+        match e
+            .get_ref()
+            .and_then(|inner| inner.downcast_ref::<orbitri::Error>())
+        {
+            Some(orbitri::Error::InvalidOption { .. }) => {
+                let inner = e.into_inner().expect("checked").downcast();
+                option_error(*inner.expect("checked"))
+            }
+            _ => CliError::Write {
+                path: output.clone(),
+                source: e,
+            },
+        }
+    })?;
     let png = output
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("png"));
@@ -427,6 +446,18 @@ fn draw(input: PathBuf, domain: Domain, output: PathBuf, opts: SvgOptions) -> Re
         path: output,
         source,
     })
+}
+
+/// An option out of range, named as the flag the user typed.
+fn option_error(e: orbitri::Error) -> CliError {
+    match e {
+        orbitri::Error::InvalidOption {
+            option,
+            value,
+            limit,
+        } => CliError::Usage(format!("--{option} {value} is out of range: {limit}")),
+        e => e.into(),
+    }
 }
 
 /// Rasterizes our SVG (no text, no images) with resvg.
@@ -571,8 +602,53 @@ fn generate(n: usize, seed: u64, dim: u8, output: Option<PathBuf>) -> Result<(),
     })
 }
 
+/// Marks the negative numbers that follow `--box` or `--lattice` (as many as
+/// `str::parse::<f64>` reads, up to the most the option takes) as values, with a leading
+/// blank that [`number`] drops.
+///
+/// clap reads a token that starts with `-` as a flag unless it is a plain negative number
+/// (`-2`, `-2.5`, `-2e5`), so `-2e-301`, `-.5` or `-inf` were unknown flags; and
+/// `allow_hyphen_values` would also take the `-o` of `--box 1 1 -o out` for a third length,
+/// as clap stops only at the most values an option takes.
+fn mark_negative_numbers(args: impl IntoIterator<Item = OsString>) -> Vec<OsString> {
+    let mut out = Vec::new();
+    let mut args = args.into_iter().peekable();
+    while let Some(arg) = args.next() {
+        let most = match arg.to_str() {
+            Some("--box") => 3,
+            Some("--lattice") => 9,
+            Some("--") => {
+                out.push(arg);
+                out.extend(args);
+                break;
+            }
+            _ => 0,
+        };
+        out.push(arg);
+        for _ in 0..most {
+            let Some(v) = args.next_if(|a| a.to_str().is_some_and(|v| v.parse::<f64>().is_ok()))
+            else {
+                break;
+            };
+            out.push(match v.to_str() {
+                Some(n) if n.starts_with('-') => format!(" {n}").into(),
+                _ => v,
+            });
+        }
+    }
+    out
+}
+
+/// A number as `str::parse::<f64>` reads it (after the blank of [`mark_negative_numbers`]).
+fn number(s: &str) -> Result<f64, String> {
+    s.strip_prefix(' ')
+        .unwrap_or(s)
+        .parse()
+        .map_err(|e: std::num::ParseFloatError| e.to_string())
+}
+
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = Cli::parse_from(mark_negative_numbers(std::env::args_os()));
     let result = match cli.command {
         Command::Triangulate { input, domain, out } => triangulate(input, domain, out),
         Command::Demo { points, seed } => demo(points, seed),

@@ -211,6 +211,18 @@ fn bad_input_gets_a_clear_error_and_exit_code_2() {
             "lattice too skewed",
         ),
         ("missing.txt", "", cube, "missing.txt: No such file"),
+        (
+            "field.txt",
+            "0 0 0\n0.1,,0.3\n",
+            cube,
+            "field.txt:2: field 2 is empty",
+        ),
+        (
+            "nul.txt",
+            "0 0 0\n0.1 0.2 0.3\n0.1 0.2\x000.3\n",
+            cube,
+            "nul.txt:3: control character U+0000 at column 8",
+        ),
     ];
     for (name, text, domain, msg) in cases {
         let path = if text.is_empty() {
@@ -227,6 +239,145 @@ fn bad_input_gets_a_clear_error_and_exit_code_2() {
     // clap: missing domain
     let o = orbitri(&["triangulate", "x.txt"]);
     assert!(!o.status.success());
+    // .npy files without points: 0 bytes, a cut header, 0 rows
+    let full = orbitri::io::encode_npy(&[[0.5, 0.5, 0.5]]);
+    for (name, bytes, msg) in [
+        ("zero.npy", &b""[..], "zero.npy:1: empty file (0 bytes)"),
+        ("cut.npy", &full[..9], "cut.npy:1: truncated .npy header"),
+        (
+            "rows.npy",
+            &orbitri::io::encode_npy::<3>(&[])[..],
+            "rows.npy:1: the file holds no points",
+        ),
+    ] {
+        let path = dir.path().join(name);
+        std::fs::write(&path, bytes).unwrap();
+        let o = triangulate_cube(&path, &[]);
+        assert_eq!(o.status.code(), Some(2), "{name}");
+        assert!(stderr(&o).contains(msg), "{name}: {}", stderr(&o));
+    }
+    // a byte-order mark at the start is no error
+    let bom = write(dir.path(), "bom.txt", "\u{feff}0.5 0.5 0.5\n");
+    let o = triangulate_cube(&bom, &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+#[test]
+fn numbers_are_read_as_rust_reads_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let p3 = write(
+        dir.path(),
+        "p3.txt",
+        "1e-4 2e-4 3e-4\n5e-4 1e-4 7e-4\n2e-4 6e-4 1e-4\n",
+    );
+    let p2 = write(dir.path(), "p2.txt", "0.1 0.2\n0.6 0.5\n0.3 0.8\n");
+    let out = dir.path().join("out.txt");
+    let out = out.to_str().unwrap();
+    let run = |input: &Path, domain: &str| {
+        let mut args = vec!["triangulate", input.to_str().unwrap()];
+        args.extend(domain.split(' '));
+        orbitri(&args)
+    };
+    // negative numbers with a negative exponent were unknown flags (`-2`); the flag after
+    // the values stays a flag, also when the option could take more values
+    for (input, domain) in [
+        (&p3, "--lattice 1e-3 0 0 3e-4 9e-4 0 -2e-4 2e-4 1.1e-3 -o"),
+        (&p2, "--lattice 1 0 -2e-1 1 -o"),
+        (&p2, "--box 1 1 -o"),
+        (&p2, "--lattice 1 -0 -.25 1E0 -o"),
+    ] {
+        let _ = std::fs::remove_file(out);
+        let o = run(input, &format!("{domain} {out}"));
+        assert!(o.status.success(), "{domain}: {}", stderr(&o));
+        let text = std::fs::read_to_string(out).unwrap();
+        // `SHEETS V C`: 3 points, in a covering space
+        assert_eq!(text.split(' ').nth(1), Some("3"), "{domain}: {text}");
+    }
+    let o = run(
+        &p3,
+        "--lattice 1e-300 0 0 3e-301 9e-301 0 -2e-301 2e-301 1.1e-300 --stats",
+    );
+    assert!(
+        o.status.success() || stderr(&o).starts_with("orbitri: error: "),
+        "not a usage error: {}",
+        stderr(&o)
+    );
+    // infinities and NaN reach the library's typed box errors
+    for (input, domain, msg) in [
+        (&p2, "--box inf 1", "invalid box: length 0 is inf"),
+        (&p2, "--box 1 -inf", "invalid box: length 1 is -inf"),
+        (&p2, "--box 1 -nan", "invalid box: length 1 is NaN"),
+        (&p2, "--box 1 -1e-3", "invalid box: length 1 is -0.001"),
+        (&p3, "--box 1 1 -.5", "invalid box: length 2 is -0.5"),
+        (
+            &p2,
+            "--lattice 1 0 -infinity 1",
+            "invalid box: lattice vector 1, component 0 is -inf",
+        ),
+        // a wrong count still errors
+        (&p2, "--lattice 1 0 0 1 -2e-1", "takes 4 numbers"),
+        (&p2, "--lattice 1 -2e-1 0", "4 values required"),
+        (&p2, "--box 1", "2 values required"),
+        (&p3, "--box 1 1 1 -5", "unexpected argument '-5'"),
+        (&p2, "--box 1 x", "invalid value 'x'"),
+    ] {
+        let o = run(input, domain);
+        assert_eq!(o.status.code(), Some(2), "{domain}");
+        assert!(stderr(&o).contains(msg), "{domain}: {}", stderr(&o));
+    }
+}
+
+#[test]
+fn draw_limits_name_the_flag_the_value_and_the_limit() {
+    let dir = tempfile::tempdir().unwrap();
+    let pts = dir.path().join("p2.txt");
+    orbitri(&[
+        "generate",
+        "3000",
+        "--dim",
+        "2",
+        "-o",
+        pts.to_str().unwrap(),
+    ]);
+    let one = write(dir.path(), "one.txt", "0.5 0.5\n");
+    let png = dir.path().join("t.png");
+    for (input, args, msg) in [
+        (&pts, "--box 1 1 --width 100000", "--width 100000 is out of range: a picture is 1 to 8192 pixels wide"),
+        (&pts, "--box 1 1 --width -1e-3", "--width -0.001 is out of range"),
+        (&pts, "--box 1 1 --width nan", "--width NaN is out of range"),
+        (&pts, "--box 1 1 --copies 1000", "--copies 1000 is out of range: at most 50 per lattice direction"),
+        (&one, "--box 1 1 --copies 51", "--copies 51 is out of range"),
+        (&pts, "--box 1 1 --copies 30", "--copies 30 is out of range: 30² copies of 3000 points make 2700000 points to draw, more than 2000000"),
+        (&one, "--box 1 9 --width 3000", "--width 3000 is out of range: the picture would be 20647 pixels high"),
+    ] {
+        let mut a = vec!["draw", input.to_str().unwrap(), "-o", png.to_str().unwrap()];
+        a.extend(args.split(' '));
+        let o = orbitri(&a);
+        assert_eq!(o.status.code(), Some(2), "{args}");
+        assert!(stderr(&o).contains(msg), "{args}: {}", stderr(&o));
+        assert!(!png.exists());
+    }
+    // at the limits
+    let svg = dir.path().join("t.svg");
+    for (input, args) in [(&one, "--copies 50"), (&pts, "--copies 25 --width 8192")] {
+        let mut a = vec![
+            "draw",
+            input.to_str().unwrap(),
+            "--box",
+            "1",
+            "1",
+            "-o",
+            svg.to_str().unwrap(),
+        ];
+        a.extend(args.split(' '));
+        let o = orbitri(&a);
+        assert!(o.status.success(), "{args}: {}", stderr(&o));
+    }
+    let help = String::from_utf8(orbitri(&["draw", "--help"]).stdout).unwrap();
+    assert!(
+        help.contains("at most 50") && help.contains("1 to 8192"),
+        "{help}"
+    );
 }
 
 #[test]

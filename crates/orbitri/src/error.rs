@@ -46,6 +46,14 @@ pub enum Error {
     /// The caller's progress or interrupt callback asked a long computation to stop.
     #[error("interrupted")]
     Interrupted,
+    /// An option out of the range a function accepts (a picture too large to draw, say):
+    /// the option's name, its value, and the limit it exceeds.
+    #[error("{option} {value} is out of range: {limit}")]
+    InvalidOption {
+        option: &'static str,
+        value: String,
+        limit: String,
+    },
 }
 
 /// The library's result type.

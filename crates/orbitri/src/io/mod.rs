@@ -7,7 +7,7 @@ mod tessellation;
 mod text;
 mod write;
 
-pub use npy::{encode_npy, encode_npy_matrix, read_npy};
+pub use npy::{encode_npy, encode_npy_matrix, parse_npy, read_npy};
 pub use svg::{write_svg, SvgOptions};
 pub use tessellation::{
     point_table, write_delaunay_vtu, write_edges_csv, write_neighbors_csv, write_voronoi_json,

@@ -24,15 +24,25 @@ fn header_value<'a>(header: &'a str, key: &str) -> Option<&'a str> {
     Some(rest[..end].trim())
 }
 
-fn parse_npy<const D: usize>(bytes: &[u8], path: &Path) -> Result<Vec<[f64; D]>> {
+/// Parses the bytes of an `(N, D)` float64 `.npy` file (what [`read_npy`] reads); `path` is
+/// only used in error messages, which all name it.
+pub fn parse_npy<const D: usize>(bytes: &[u8], path: &Path) -> Result<Vec<[f64; D]>> {
     let dim = D;
     let err = |message: String| Error::Parse {
         file: path.to_path_buf(),
         line: 1,
         message,
     };
-    if bytes.len() < 10 || &bytes[..6] != b"\x93NUMPY" {
+    const MAGIC: &[u8] = b"\x93NUMPY";
+    if bytes.is_empty() {
+        return Err(err("empty file (0 bytes), not a .npy array".into()));
+    }
+    if !bytes.starts_with(&MAGIC[..bytes.len().min(MAGIC.len())]) {
         return Err(err("not a .npy file (bad magic)".into()));
+    }
+    let truncated = || err(format!("truncated .npy header ({} bytes)", bytes.len()));
+    if bytes.len() < 10 {
+        return Err(truncated());
     }
     let (hlen, start) = match bytes[6] {
         1 => (u16::from_le_bytes([bytes[8], bytes[9]]) as usize, 10),
@@ -40,11 +50,10 @@ fn parse_npy<const D: usize>(bytes: &[u8], path: &Path) -> Result<Vec<[f64; D]>>
             u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]) as usize,
             12,
         ),
+        2 | 3 => return Err(truncated()),
         v => return Err(err(format!("unsupported .npy version {v}"))),
     };
-    let header = bytes
-        .get(start..start + hlen)
-        .ok_or_else(|| err("truncated .npy header".into()))?;
+    let header = bytes.get(start..start + hlen).ok_or_else(truncated)?;
     let header = std::str::from_utf8(header).map_err(|_| err("bad .npy header".into()))?;
     let descr =
         header_value(header, "descr").ok_or_else(|| err("no dtype in .npy header".into()))?;
@@ -76,14 +85,15 @@ fn parse_npy<const D: usize>(bytes: &[u8], path: &Path) -> Result<Vec<[f64; D]>>
     }
     let data = &bytes[start + hlen..];
     let n = dims[0];
-    if data.len() < n * dim * 8 {
+    // a shape from a corrupt header can overflow the byte count
+    if n.checked_mul(dim * 8).is_none_or(|len| data.len() < len) {
         return Err(err(format!(
             "truncated data: {} bytes for {n}×{dim} float64",
             data.len()
         )));
     }
     if n == 0 {
-        return Err(Error::EmptyInput);
+        return Err(err(format!("the file holds no points (shape {shape})")));
     }
     let mut out = Vec::with_capacity(n);
     for i in 0..n {
@@ -159,5 +169,58 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("truncated"), "{e}");
+    }
+
+    fn error(bytes: &[u8]) -> String {
+        parse_npy::<3>(bytes, Path::new("a.npy"))
+            .unwrap_err()
+            .to_string()
+    }
+
+    #[test]
+    fn empty_and_truncated_files_name_the_file() {
+        // 0 rows: was the untyped-to-the-file "the input holds no points"
+        let empty = encode_npy::<3>(&[]);
+        assert_eq!(
+            error(&empty),
+            "a.npy:1: the file holds no points (shape (0, 3))"
+        );
+        assert_eq!(
+            error(b""),
+            "a.npy:1: empty file (0 bytes), not a .npy array"
+        );
+        // a header cut anywhere, also before the version bytes or within the magic
+        let b = encode_npy(&[[0.1, 0.2, 0.3]]);
+        let header_end = b.len() - 24;
+        for cut in 1..header_end {
+            let e = error(&b[..cut]);
+            assert!(
+                e.starts_with("a.npy:1: truncated .npy header"),
+                "{cut}: {e}"
+            );
+        }
+        let mut v2 = b"\x93NUMPY\x02\x00\x10\x00".to_vec();
+        assert_eq!(error(&v2), "a.npy:1: truncated .npy header (10 bytes)");
+        v2.extend_from_slice(&[0, 0]);
+        assert!(error(&v2).starts_with("a.npy:1: truncated .npy header"));
+        assert!(error(b"\x93NUMPX\x01\x00").contains("bad magic"));
+    }
+
+    #[test]
+    fn a_huge_shape_is_truncated_data_not_an_overflow() {
+        let mut b = encode_npy(&[[0.1, 0.2, 0.3]]);
+        let header_end = 10 + u16::from_le_bytes([b[8], b[9]]) as usize;
+        let header = String::from_utf8(b[10..header_end].to_vec()).unwrap();
+        // the same header length: the shape's extra digits replace padding blanks
+        let huge = format!("({}, 3)", usize::MAX);
+        let mut header = header.replace("(1, 3)", &huge);
+        let newline = header.len() - 1;
+        header.replace_range(newline - (huge.len() - "(1, 3)".len())..newline, "");
+        b.splice(10..header_end, header.bytes());
+        let e = error(&b);
+        assert!(
+            e.starts_with("a.npy:1: truncated data: 24 bytes for"),
+            "{e}"
+        );
     }
 }

@@ -4,6 +4,7 @@
 use std::fmt::Write as _;
 use std::io::Write;
 
+use crate::error::{Error, Result};
 use crate::periodic::PeriodicDelaunay2;
 use crate::space::Lattice;
 
@@ -18,6 +19,58 @@ pub struct SvgOptions {
     pub delaunay: bool,
     pub voronoi: bool,
     pub points: bool,
+}
+
+impl SvgOptions {
+    /// The largest width and height of a picture, in pixels: a PNG of 8192² pixels takes
+    /// about 0.8 GB of memory to render and encode (16384² took 3.2 GB and 45 s).
+    pub const MAX_SIZE: f64 = 8192.0;
+    /// The most copies of the domain per lattice direction.
+    pub const MAX_COPIES: u32 = 50;
+    /// The most points drawn, copies included (`copies² × points`): about 240 bytes of SVG
+    /// each, so at most about 500 MB.
+    pub const MAX_DRAWN_POINTS: u64 = 2_000_000;
+
+    /// Checks the options for a picture of `points` points: a width from 1 to
+    /// [`MAX_SIZE`](Self::MAX_SIZE) pixels, at most [`MAX_COPIES`](Self::MAX_COPIES) copies
+    /// and [`MAX_DRAWN_POINTS`](Self::MAX_DRAWN_POINTS) points drawn. [`write_svg`] also
+    /// checks that the height, from the domain's aspect ratio, is at most `MAX_SIZE`.
+    pub fn validate(&self, points: usize) -> Result<()> {
+        let invalid = |option, value: String, limit: String| {
+            Err(Error::InvalidOption {
+                option,
+                value,
+                limit,
+            })
+        };
+        if !(1.0..=Self::MAX_SIZE).contains(&self.width) {
+            return invalid(
+                "width",
+                self.width.to_string(),
+                format!("a picture is 1 to {} pixels wide", Self::MAX_SIZE),
+            );
+        }
+        if self.copies > Self::MAX_COPIES {
+            return invalid(
+                "copies",
+                self.copies.to_string(),
+                format!("at most {} per lattice direction", Self::MAX_COPIES),
+            );
+        }
+        let k = u64::from(self.copies.max(1));
+        let drawn = k * k * points as u64;
+        if drawn > Self::MAX_DRAWN_POINTS {
+            return invalid(
+                "copies",
+                self.copies.to_string(),
+                format!(
+                    "{k}² copies of {points} points make {drawn} points to draw, more than {}",
+                    Self::MAX_DRAWN_POINTS
+                ),
+            );
+        }
+        Ok(())
+    }
 }
 
 impl Default for SvgOptions {
@@ -63,10 +116,14 @@ impl Page<'_> {
         self.lattice.cartesian(&f)
     }
 
-    /// A polyline or point, with its extent in fractional coordinates.
-    fn shape(&self, pts: Vec<[f64; 2]>) -> Shape {
+    /// A polyline or point, with its extent in fractional coordinates. A shape with a
+    /// non-finite coordinate is left out (empty, at no translation): no `NaN` in the SVG.
+    fn shape(&self, mut pts: Vec<[f64; 2]>) -> Shape {
         let mut fmin = [f64::INFINITY; 2];
         let mut fmax = [f64::NEG_INFINITY; 2];
+        if !pts.as_flattened().iter().all(|x| x.is_finite()) {
+            pts.clear();
+        }
         for p in &pts {
             let f = self.lattice.fractional(p);
             for c in 0..2 {
@@ -107,6 +164,29 @@ impl Page<'_> {
     }
 }
 
+#[cfg(test)]
+#[test]
+fn a_shape_with_a_non_finite_coordinate_is_not_drawn() {
+    let lattice = Lattice::new([[1.0, 0.0], [0.0, 1.0]]).unwrap();
+    let page = Page {
+        lo: -1.0,
+        hi: 2.0,
+        lattice: &lattice,
+        origin: [0.0; 2],
+        top: 0.0,
+        scale: 100.0,
+    };
+    let good = page.shape(vec![[0.1, 0.2], [0.3, 0.4]]);
+    assert_eq!(page.translations(&good).count(), 9);
+    for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+        let s = page.shape(vec![[0.1, 0.2], [bad, 0.4], [0.5, 0.6]]);
+        assert_eq!(page.translations(&s).count(), 0);
+        let d = page.path(&[s, page.shape(vec![[0.1, 0.2], [0.3, 0.4]])]);
+        assert!(!d.contains("NaN") && !d.contains("inf"), "{d}");
+        assert_eq!(d, page.path(&[page.shape(vec![[0.1, 0.2], [0.3, 0.4]])]));
+    }
+}
+
 /// The Delaunay edges (one per orbit) as segments from the library's edge list.
 fn delaunay_edges(page: &Page, tri: &PeriodicDelaunay2) -> Vec<Shape> {
     let at = |i: u32| tri.point(tri.vertex_of_input(i as usize));
@@ -133,12 +213,17 @@ fn voronoi_cells(page: &Page, tri: &PeriodicDelaunay2) -> Vec<Shape> {
         .collect()
 }
 
-/// Writes the picture as SVG.
+/// Writes the picture as SVG. Options out of range (see [`SvgOptions::validate`]) give an
+/// error of kind `InvalidInput` whose inner error is the typed [`Error::InvalidOption`],
+/// before anything is written.
 pub fn write_svg(
     w: &mut impl Write,
     tri: &PeriodicDelaunay2,
     opts: &SvgOptions,
 ) -> std::io::Result<()> {
+    let out_of_range = |e: Error| std::io::Error::new(std::io::ErrorKind::InvalidInput, e);
+    opts.validate(tri.number_of_vertices())
+        .map_err(out_of_range)?;
     let k = opts.copies.max(1) as f64;
     let lo = -f64::from((opts.copies.max(1) - 1) / 2);
     let mut page = Page {
@@ -164,6 +249,16 @@ pub fn write_svg(
     page.top = ymax + pad;
     page.scale = opts.width / (xmax - xmin + 2.0 * pad);
     let height = (ymax - ymin + 2.0 * pad) * page.scale;
+    if height.is_nan() || height > SvgOptions::MAX_SIZE {
+        return Err(out_of_range(Error::InvalidOption {
+            option: "width",
+            value: opts.width.to_string(),
+            limit: format!(
+                "the picture would be {height:.0} pixels high (the domain's aspect ratio), more than {}",
+                SvgOptions::MAX_SIZE
+            ),
+        }));
+    }
     // strokes scale with the density of the picture
     let n = tri.number_of_vertices().max(1) as f64;
     let stroke = (opts.width / (k * n.sqrt()) / 25.0).clamp(0.15, 1.5);

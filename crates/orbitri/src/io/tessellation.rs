@@ -7,6 +7,7 @@ use std::fmt::Write as _;
 use std::io::Write;
 
 use super::npy::encode_npy_matrix;
+use super::write::json_f64;
 use crate::periodic::{PeriodicDelaunay, Torus};
 use crate::space::FlatTorus;
 use crate::voronoi::{CellMeasures, Neighbor, VoronoiCell};
@@ -131,7 +132,7 @@ where
 }
 
 fn json_point(p: &[f64]) -> String {
-    let v: Vec<String> = p.iter().map(|x| format!("{x:?}")).collect();
+    let v: Vec<String> = p.iter().map(|&x| json_f64(x)).collect();
     format!("[{}]", v.join(","))
 }
 
@@ -165,19 +166,22 @@ where
             .iter()
             .map(|f| {
                 format!(
-                    "{{\"vertices\":{:?},\"neighbor\":{},\"shift\":{:?},\"area\":{:?}}}",
-                    f.vertices, f.neighbor, f.shift, f.area
+                    "{{\"vertices\":{:?},\"neighbor\":{},\"shift\":{:?},\"area\":{}}}",
+                    f.vertices,
+                    f.neighbor,
+                    f.shift,
+                    json_f64(f.area)
                 )
                 .replace(' ', "")
             })
             .collect();
         write!(
             w,
-            "{}{{\"id\":{},\"position\":{},\"volume\":{:?},\"centroid\":{},\"vertices\":[{}],\"faces\":[{}]}}",
+            "{}{{\"id\":{},\"position\":{},\"volume\":{},\"centroid\":{},\"vertices\":[{}],\"faces\":[{}]}}",
             if k > 0 { "," } else { "" },
             c.point,
             json_point(&c.position),
-            c.volume,
+            json_f64(c.volume),
             json_point(&c.centroid),
             vertices.join(","),
             faces.join(",")

@@ -1,10 +1,23 @@
 //! Text points: one point per line, coordinates separated by blanks or commas, `#` starts a
-//! comment, blank lines are skipped.
+//! comment, blank lines are skipped. A UTF-8 byte-order mark at the start of the file is
+//! skipped; an empty field between commas and a control character (other than tab, CR and
+//! LF) are errors.
 
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 
 use crate::error::{Error, Result};
+
+/// The most characters of a line or value that an error message quotes.
+const QUOTE_CHARS: usize = 80;
+
+/// `s`, cut after [`QUOTE_CHARS`] characters (marked with `…`), for an error message.
+fn clip(s: &str) -> String {
+    match s.char_indices().nth(QUOTE_CHARS) {
+        Some((end, _)) => format!("{}…", &s[..end]),
+        None => s.to_string(),
+    }
+}
 
 /// Reads a text point file, streaming it line by line.
 pub fn read_text<const D: usize>(path: &Path) -> Result<Vec<[f64; D]>> {
@@ -15,9 +28,10 @@ pub fn read_text<const D: usize>(path: &Path) -> Result<Vec<[f64; D]>> {
     parse_lines(BufReader::new(file), path)
 }
 
-/// Parses text points; `file` is only used in error messages.
-pub fn parse_text<const D: usize>(text: &str, file: &Path) -> Result<Vec<[f64; D]>> {
-    parse_lines(text.as_bytes(), file)
+/// Parses text points from a string or raw bytes (which must be UTF-8); `file` is only used
+/// in error messages.
+pub fn parse_text<const D: usize>(text: impl AsRef<[u8]>, file: &Path) -> Result<Vec<[f64; D]>> {
+    parse_lines(text.as_ref(), file)
 }
 
 fn parse_lines<const D: usize>(mut input: impl BufRead, file: &Path) -> Result<Vec<[f64; D]>> {
@@ -41,32 +55,74 @@ fn parse_lines<const D: usize>(mut input: impl BufRead, file: &Path) -> Result<V
             break;
         }
         line += 1;
-        let raw = std::str::from_utf8(&buf).map_err(|_| {
+        let raw = std::str::from_utf8(&buf).map_err(|e| {
+            let ok = &buf[..e.valid_up_to()];
+            let column = std::str::from_utf8(ok).map_or(0, |s| s.chars().count()) + 1;
             err(
                 line,
-                "not UTF-8 text (for binary input use a .npy file)".into(),
+                format!(
+                    "not UTF-8 text (byte 0x{:02X} at column {column}; for binary input use a .npy file)",
+                    buf[ok.len()]
+                ),
             )
         })?;
-        let body = raw.split('#').next().unwrap_or("");
-        let mut p = [0.0; D];
-        let mut count = 0;
-        for f in body
-            .split(|c: char| c == ',' || c.is_whitespace())
-            .filter(|s| !s.is_empty())
-        {
-            if count < D {
-                let v: f64 = f
-                    .parse()
-                    .map_err(|_| err(line, format!("coordinate {count} '{f}' is not a number")))?;
-                if !v.is_finite() {
+        let raw = match line {
+            1 => raw.strip_prefix('\u{feff}').unwrap_or(raw),
+            _ => raw,
+        };
+        // a fast test first: most lines are printable ASCII with tabs and line ends
+        let plain = |b: &u8| (0x20..0x7f).contains(b) || matches!(b, b'\t' | b'\r' | b'\n');
+        if !raw.as_bytes().iter().all(plain) {
+            for (k, c) in raw.chars().enumerate() {
+                let column = k + 1;
+                if c.is_control() && !matches!(c, '\t' | '\r' | '\n') {
+                    let code = c as u32;
                     return Err(err(
                         line,
-                        format!("coordinate {count} is {v}, not a finite number"),
+                        format!("control character U+{code:04X} at column {column}"),
                     ));
                 }
-                p[count] = v;
+                if c == '\u{feff}' {
+                    return Err(err(
+                        line,
+                        format!(
+                            "byte-order mark U+FEFF at column {column} (allowed only at the start of the file)"
+                        ),
+                    ));
+                }
             }
-            count += 1;
+        }
+        let body = raw.split('#').next().unwrap_or("");
+        let commas = body.contains(',');
+        let mut p = [0.0; D];
+        let mut count = 0;
+        for (field, text) in body.split(',').enumerate() {
+            let mut values = text.split(char::is_whitespace).filter(|s| !s.is_empty());
+            let first = values.next();
+            if first.is_none() && commas {
+                return Err(err(
+                    line,
+                    format!("field {} is empty ({:?})", field + 1, clip(body.trim())),
+                ));
+            }
+            for f in first.into_iter().chain(values) {
+                if count < D {
+                    let v: f64 = f.parse().map_err(|_| {
+                        err(
+                            line,
+                            format!("coordinate {count} '{}' is not a number", clip(f)),
+                        )
+                    })?;
+                    if !v.is_finite() {
+                        return Err(err(
+                            line,
+                            format!("coordinate {count} is {v}, not a finite number"),
+                        ));
+                    }
+                    p[count] = v;
+                }
+                count += 1;
+            }
         }
         if count == 0 {
             continue;
@@ -76,7 +132,7 @@ fn parse_lines<const D: usize>(mut input: impl BufRead, file: &Path) -> Result<V
                 line,
                 format!(
                     "expected {D} coordinates, found {count} ({:?})",
-                    body.trim()
+                    clip(body.trim())
                 ),
             ));
         }
@@ -121,5 +177,108 @@ mod tests {
         assert!(e.starts_with("in.txt:2: not UTF-8"), "{e}");
         let e = parse("# only a comment\n").unwrap_err().to_string();
         assert_eq!(e, "in.txt:1: the file holds no points");
+    }
+
+    fn error(s: &str) -> String {
+        parse(s).unwrap_err().to_string()
+    }
+
+    #[test]
+    fn an_empty_field_is_an_error() {
+        // it used to be dropped, turning a 3D row into a 2D one
+        assert_eq!(
+            error("0 0 0\n\n0.1,,0.3\n"),
+            "in.txt:3: field 2 is empty (\"0.1,,0.3\")"
+        );
+        assert!(error("0.1,0.2,0.3,\n").starts_with("in.txt:1: field 4 is empty"));
+        assert!(error(",0.1,0.2,0.3\n").starts_with("in.txt:1: field 1 is empty"));
+        assert!(error("0.1, ,0.3\n").starts_with("in.txt:1: field 2 is empty"));
+        assert!(error("0.1,0.2,0.3, # a comment\n").starts_with("in.txt:1: field 4 is empty"));
+        // a 2D row with a missing value is not taken for a complete 2D point
+        let e = parse_text::<2>("0.1,0.2,\n", Path::new("in.txt"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("in.txt:1: field 3 is empty"), "{e}");
+        // blanks around commas, blanks only, and commas mixed with blanks stay fine
+        let p = parse("0.1 , 0.2 ,\t0.3\n0.4 0.5 0.6\n0.7, 0.8 0.9\n").unwrap();
+        assert_eq!(p, vec![[0.1, 0.2, 0.3], [0.4, 0.5, 0.6], [0.7, 0.8, 0.9]]);
+    }
+
+    #[test]
+    fn a_byte_order_mark_at_the_start_is_skipped() {
+        let p = parse("\u{feff}0.1 0.2 0.3\n0.4 0.5 0.6\n").unwrap();
+        assert_eq!(p, vec![[0.1, 0.2, 0.3], [0.4, 0.5, 0.6]]);
+        let p = parse("\u{feff}# x y z\n0.1,0.2,0.3\n").unwrap();
+        assert_eq!(p, vec![[0.1, 0.2, 0.3]]);
+        // anywhere else (two files concatenated) it is named
+        assert_eq!(
+            error("0.1 0.2 0.3\n\u{feff}0.4 0.5 0.6\n"),
+            "in.txt:2: byte-order mark U+FEFF at column 1 (allowed only at the start of the file)"
+        );
+    }
+
+    #[test]
+    fn control_characters_are_named() {
+        assert_eq!(
+            error("0 0 0\n0.1 0\u{0}2 0.3\n"),
+            "in.txt:2: control character U+0000 at column 6"
+        );
+        assert_eq!(
+            error("0.1\u{b}0.2 0.3\n"),
+            "in.txt:1: control character U+000B at column 4"
+        );
+        // the column counts characters, not bytes; C1 controls and DEL too
+        assert_eq!(
+            error("# é\n0.1 0.2 0.3 \u{85}\n"),
+            "in.txt:2: control character U+0085 at column 13"
+        );
+        assert_eq!(
+            error("0.1 0.2 0.3\u{7f}\n"),
+            "in.txt:1: control character U+007F at column 12"
+        );
+        // tabs and CRLF line ends are fine
+        assert_eq!(parse("0.1\t0.2\t0.3\r\n").unwrap(), vec![[0.1, 0.2, 0.3]]);
+        let e = parse_lines::<3>(&b"0.1 \xc3\xa9\xff 0.3\n"[..], Path::new("in.txt"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("in.txt:1: not UTF-8 text (byte 0xFF at column 6;"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn long_lines_are_quoted_shortly() {
+        let row = "0.125 ".repeat(10_000);
+        let e = error(&row);
+        assert!(
+            e.starts_with("in.txt:1: expected 3 coordinates, found 10000"),
+            "{e}"
+        );
+        assert!(e.ends_with("…\")"), "{e}");
+        assert!(e.chars().count() < 160, "{e}");
+        let e = error(&format!("0.5 0.5 {}\n", "x".repeat(100_000)));
+        assert!(e.starts_with("in.txt:1: coordinate 2 'xxx"), "{e}");
+        assert!(e.ends_with("…' is not a number"), "{e}");
+        assert!(e.chars().count() < 160, "{e}");
+        let e = error(&format!("{},,1\n", "1 ".repeat(1000)));
+        assert!(
+            e.contains("field 2 is empty") && e.chars().count() < 160,
+            "{e}"
+        );
+        // a short line is quoted whole
+        assert_eq!(clip("0.1 0.2"), "0.1 0.2");
+        assert_eq!(clip(&"é".repeat(81)), format!("{}…", "é".repeat(80)));
+    }
+
+    #[test]
+    fn bytes_and_strings_parse_alike() {
+        let text = "0.1 0.2 0.3\n";
+        assert_eq!(
+            parse_text::<3>(text.as_bytes(), Path::new("in.txt")).unwrap(),
+            parse(text).unwrap()
+        );
+        let e = parse_text::<3>(b"", Path::new("in.txt")).unwrap_err();
+        assert_eq!(e.to_string(), "in.txt:1: the file holds no points");
     }
 }

@@ -44,9 +44,25 @@ where
     Ok(())
 }
 
-fn json_f64(x: f64) -> String {
-    // shortest representation that reads back to the same double
-    format!("{x:?}")
+/// A JSON number: the shortest representation that reads back to the same double, or
+/// `null` for NaN and ±inf, which JSON cannot hold (a bare `NaN` makes the file invalid).
+pub(super) fn json_f64(x: f64) -> String {
+    if x.is_finite() {
+        format!("{x:?}")
+    } else {
+        "null".into()
+    }
+}
+
+#[cfg(test)]
+#[test]
+fn json_f64_writes_null_for_non_finite_numbers() {
+    assert_eq!(json_f64(0.1), "0.1");
+    assert_eq!(json_f64(-1e-300), "-1e-300");
+    assert_eq!(json_f64(-0.0), "-0.0");
+    for x in [f64::NAN, -f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+        assert_eq!(json_f64(x), "null");
+    }
 }
 
 /// JSON: `{"dimension", "sheets", "lattice", "points" (wrapped, input order),
