@@ -205,6 +205,7 @@ fn delaunay_edges(page: &Page, tri: &PeriodicDelaunay2) -> Vec<Shape> {
 fn voronoi_cells(page: &Page, tri: &PeriodicDelaunay2) -> Vec<Shape> {
     tri.voronoi_cells()
         .into_iter()
+        .filter(|c| !c.vertices.is_empty())
         .map(|c| {
             let mut pts = c.vertices;
             pts.push(pts[0]);
