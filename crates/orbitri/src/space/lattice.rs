@@ -379,10 +379,18 @@ impl<const D: usize> Lattice<D> {
     /// set (Lemma 2.3.8 of the thesis for cuboids). A cube uses 3 per axis (Theorem 2.2.8).
     /// At most [`MAX_COPIES`] per axis: more elongated boxes are rejected at construction.
     pub fn covering(&self) -> [i32; D] {
+        self.covering_search().0
+    }
+
+    /// [`Self::covering`] and the number of steps its search took: each step adds one copy
+    /// along one vector, and the search stops once a count exceeds [`MAX_COPIES`], so it
+    /// takes at most `D·MAX_COPIES + 1` steps whatever the lattice.
+    fn covering_search(&self) -> ([i32; D], usize) {
         let l0 = self.rows.m[0][0];
         if self.rows.diagonal && (0..D).all(|i| self.rows.m[i][i] == l0) {
-            return [3; D];
+            return ([3; D], 0);
         }
+        let mut steps = 0;
         let big = self.one_point_need();
         // start below the answer and grow the copies along the currently shortest vector
         let mut h: [i32; D] =
@@ -398,8 +406,9 @@ impl<const D: usize> Lattice<D> {
                 la.total_cmp(&lb)
             });
             h[i.unwrap()] += 1;
+            steps += 1;
         }
-        h
+        (h, steps)
     }
 
     /// Twice the largest empty-ball diameter one point's orbit can leave, bounded by
@@ -840,6 +849,44 @@ mod tests {
             .unwrap()
             .check_volume_representable()
             .is_ok());
+    }
+
+    /// Elongated and skewed lattices: the covering search ends within its step bound (a
+    /// step count, not the clock), with a covering or the "too elongated" error.
+    #[test]
+    fn covering_search_is_bounded() {
+        let mut seed = 99u64;
+        let mut unit = move || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..400 {
+            let l: [f64; 3] = std::array::from_fn(|_| 2f64.powf(12.0 * unit() - 6.0));
+            let t: [f64; 3] = std::array::from_fn(|_| unit() - 0.5);
+            let m = [
+                [l[0], 0.0, 0.0],
+                [t[0] * l[0], l[1], 0.0],
+                [t[1] * l[0], t[2] * l[1], l[2]],
+            ];
+            let Ok(lattice) = Lattice::new(m) else {
+                continue;
+            };
+            let (h, steps) = lattice.covering_search();
+            assert!(
+                steps <= 3 * MAX_COPIES as usize + 1,
+                "{steps} steps for {m:?}"
+            );
+            assert!(h.iter().all(|&x| x <= MAX_COPIES));
+            // and the search from an unchecked lattice stops too
+            let raw = Lattice {
+                rows: Rows {
+                    m: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1e-3]],
+                    diagonal: true,
+                },
+                ..lattice.clone()
+            };
+            assert!(raw.covering_search().1 <= 3 * MAX_COPIES as usize + 1);
+        }
     }
 
     #[test]
