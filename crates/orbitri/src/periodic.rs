@@ -17,12 +17,12 @@ pub type Offset<const D: usize = 3> = [i8; D];
 /// The flat tori the facade serves: `FlatTorus<D>` as an orbit space with cells of `N`
 /// vertices, points `[f64; D]` and offsets `[i8; D]`.
 pub trait Torus<const D: usize, const N: usize>:
-    OrbitSpace<N, Point = [f64; D], Offset = [i8; D]> + Clone
+    OrbitSpace<N, Point = [f64; D], Elem = [i8; D]> + Clone
 {
 }
 
 impl<const D: usize, const N: usize> Torus<D, N> for FlatTorus<D> where
-    FlatTorus<D>: OrbitSpace<N, Point = [f64; D], Offset = [i8; D]>
+    FlatTorus<D>: OrbitSpace<N, Point = [f64; D], Elem = [i8; D]>
 {
 }
 

@@ -262,7 +262,7 @@ where
                     let shift = e.translation(c, x, d);
                     let opposite = (
                         e.points()[e.point_of(dc.v[y]) as usize],
-                        torus.compose(dc.off[y], shift),
+                        torus.compose(shift, dc.off[y]),
                     );
                     torus.cospherical(&lifted, opposite).then_some((c, d))
                 })
@@ -337,10 +337,7 @@ where
         for (s, &(c, k)) in star.iter().enumerate() {
             let cell = e.cell(c);
             for j in (0..N).filter(|&j| j != k as usize) {
-                let key = (
-                    cell.v[j],
-                    torus.difference(cell.off[j], cell.off[k as usize]),
-                );
+                let key = (cell.v[j], torus.relative(cell.off[j], cell.off[k as usize]));
                 let f = edges.iter().position(|x| *x == key).unwrap_or_else(|| {
                     edges.push(key);
                     edges.len() - 1
@@ -413,7 +410,7 @@ where
             let cell = e.cell(c);
             let j = (0..N)
                 .find(|&j| {
-                    j != k && cell.v[j] == w && e.space().difference(cell.off[j], cell.off[k]) == r
+                    j != k && cell.v[j] == w && e.space().relative(cell.off[j], cell.off[k]) == r
                 })
                 .expect("the ring cell holds the edge");
             let next = (0..N)

@@ -11,7 +11,7 @@ use crate::tds::{Cell, Tds, NONE};
 impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// The vertex id of the lifted copy `(p, o)` at the current level: `sheets` ids per
     /// point, sheet by sheet (the point id itself in the quotient).
-    fn vertex_id(&self, p: u32, o: S::Offset) -> u32 {
+    fn vertex_id(&self, p: u32, o: S::Elem) -> u32 {
         let sheets = self.space.sheets(self.level) as u32;
         p * sheets + self.space.sheet_of(o, self.level) as u32
     }
@@ -41,7 +41,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.big.clear();
         self.big_count = 0;
         self.hint = NONE;
-        self.hint_shift = S::Offset::default();
+        self.hint_shift = self.space.identity();
     }
 
     /// Triangulates the current points from scratch by gift wrapping in the space of
@@ -51,7 +51,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.guaranteed = false;
         self.enter_level(level);
         let radius = self.space.edge_bound(level);
-        let a = (0u32, (self.points[0], S::Offset::default()));
+        let a = (0u32, (self.points[0], self.space.identity()));
         let cands = self.wrap_candidates(a.1, radius);
         let max_r2 = (radius / 2.0) * (radius / 2.0) * (1.0 + 1e-9);
         let first = self
@@ -111,7 +111,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         if self.one_sheeted {
             return true;
         }
-        let mut seen: HashMap<(u32, u32), S::Offset> = HashMap::new();
+        let mut seen: HashMap<(u32, u32), S::Elem> = HashMap::new();
         for c in self.tds.ids() {
             let cell = &self.tds.cells[c as usize];
             for a in 0..N {
@@ -126,7 +126,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                     if pa == pb {
                         return false;
                     }
-                    let rel = self.space.difference(cell.off[b], cell.off[a]);
+                    let rel = self.space.relative(cell.off[b], cell.off[a]);
                     if *seen.entry((pa, pb)).or_insert(rel) != rel {
                         return false;
                     }
@@ -147,7 +147,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         let old_vpoint = std::mem::take(&mut self.vpoint);
         let mut orbit = vec![NONE; old.cells.len()];
         let mut reps: Vec<u32> = Vec::new();
-        let mut index: HashMap<[(u32, S::Offset); N], u32> = HashMap::new();
+        let mut index: HashMap<[(u32, S::Elem); N], u32> = HashMap::new();
         for c in old.ids() {
             let key = quotient_key(&self.space, &old_vpoint, &old.cells[c as usize], level);
             orbit[c as usize] = *index.entry(key).or_insert_with(|| {
@@ -207,12 +207,12 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
 pub(super) fn quotient_key<S: OrbitSpace<N>, const N: usize>(
     space: &S,
     vpoint: &[u32],
-    cell: &Cell<S::Offset, N>,
+    cell: &Cell<S::Elem, N>,
     level: usize,
-) -> [(u32, S::Offset); N] {
+) -> [(u32, S::Elem); N] {
     let mut off = cell.off;
     space.normalize(&mut off, level);
-    let mut pairs: [(u32, S::Offset); N] =
+    let mut pairs: [(u32, S::Elem); N] =
         std::array::from_fn(|i| (vpoint[cell.v[i] as usize], off[i]));
     pairs.sort_unstable();
     pairs

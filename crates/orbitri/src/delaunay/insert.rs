@@ -18,7 +18,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// The cell containing the lifted point `q`, and `q`'s offset in that cell's frame.
     /// Remembering stochastic walk: never step back through the facet just crossed, and try
     /// the facets in a random rotation.
-    pub fn locate_from(&mut self, q: LiftedOf<S, N>, start: u32) -> (u32, S::Offset) {
+    pub fn locate_from(&mut self, q: LiftedOf<S, N>, start: u32) -> (u32, S::Elem) {
         let (p, mut qo) = q;
         let mut c = start;
         let mut prev = NONE;
@@ -38,7 +38,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 s[i] = keep;
                 if o == Sign::Negative {
                     let t = self.translation(c, i, d);
-                    qo = self.space.difference(qo, t);
+                    qo = self.space.relative(qo, t);
                     prev = c;
                     c = d;
                     continue 'walk;
@@ -49,14 +49,14 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     }
 
     /// The cell containing the point (offset 0), starting from the last insertion.
-    pub fn locate(&mut self, p: S::Point) -> (u32, S::Offset) {
+    pub fn locate(&mut self, p: S::Point) -> (u32, S::Elem) {
         let (start, shift) = self.start_cell();
         self.locate_from((p, shift), start)
     }
 
     /// Collects the cells whose circumsphere contains `q` (starting at `c0`, which contains
     /// `q`) and the facets bounding them.
-    fn find_conflicts(&mut self, c0: u32, q0: S::Offset, p: S::Point) {
+    fn find_conflicts(&mut self, c0: u32, q0: S::Elem, p: S::Point) {
         let (inside, outside) = self.tds.new_visit();
         let mut scratch = std::mem::take(&mut self.scratch);
         scratch.conflict.clear();
@@ -73,7 +73,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                     continue;
                 }
                 if st != outside {
-                    let qd = self.space.difference(qo, self.translation(c, i, d));
+                    let qd = self.space.relative(qo, self.translation(c, i, d));
                     if self.space.in_sphere(&self.lifted_cell(d), (p, qd)) == Sign::Positive {
                         self.tds.set_stamp(d, inside);
                         self.tds.prefetch_neighbours(d);
@@ -91,7 +91,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
 
     /// Replaces the conflict region by the cone from the new vertex `x` (lifted with offset
     /// `qoff` as inserted) over its boundary.
-    fn star_hole(&mut self, x: u32, qoff: S::Offset) {
+    fn star_hole(&mut self, x: u32, qoff: S::Elem) {
         let mut scratch = std::mem::take(&mut self.scratch);
         let inside = self.tds.stamp(scratch.conflict[0].0);
         scratch.created.clear();
@@ -159,7 +159,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.hint = first;
         self.hint_shift = self
             .space
-            .difference(self.tds.cells[first as usize].off[k], qoff);
+            .carry(qoff, self.tds.cells[first as usize].off[k]);
         self.scratch = scratch;
     }
 
@@ -177,12 +177,12 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         {
             return false;
         }
-        let mut seen: Vec<(u32, S::Offset)> = Vec::new();
+        let mut seen: Vec<(u32, S::Elem)> = Vec::new();
         for &(ci, i) in &self.scratch.boundary {
             let (c, qo) = self.scratch.conflict[ci as usize];
             let cell = &self.tds.cells[c as usize];
             for k in (0..N).filter(|&k| k != i as usize) {
-                let rel = self.space.difference(cell.off[k], qo);
+                let rel = self.space.relative(cell.off[k], qo);
                 match seen.iter().find(|e| e.0 == cell.v[k]) {
                     Some(e) if e.1 != rel => return false,
                     Some(_) => {}
@@ -201,12 +201,12 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         check_duplicate: bool,
     ) -> Result<(), Refused> {
         let (start, shift) = self.start_cell();
-        let (c, qo) = self.locate_from((q.0, self.space.compose(q.1, shift)), start);
+        let (c, qo) = self.locate_from((q.0, self.space.compose(shift, q.1)), start);
         if check_duplicate {
             for i in 0..N {
                 if self.space.coincide(self.lifted(c, i), (q.0, qo)) {
                     self.hint = c;
-                    self.hint_shift = self.space.difference(qo, q.1);
+                    self.hint_shift = self.space.carry(q.1, qo);
                     return Err(Refused::Duplicate(self.tds.cells[c as usize].v[i]));
                 }
             }
@@ -232,7 +232,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             self.points.push(p);
             self.vpoint.push(pi);
             self.vcell.push(NONE);
-            match self.insert_lifted((p, S::Offset::default()), pi, true) {
+            match self.insert_lifted((p, self.space.identity()), pi, true) {
                 Ok(()) => {
                     if !self.guaranteed && self.big_count == 0 {
                         self.set_guaranteed(true);

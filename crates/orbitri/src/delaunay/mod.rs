@@ -21,14 +21,14 @@ pub use validate::Invalid;
 
 /// A lifted point of the space `S` (cells of `N` vertices).
 pub type LiftedOf<S, const N: usize> =
-    Lifted<<S as OrbitSpace<N>>::Point, <S as OrbitSpace<N>>::Offset>;
+    Lifted<<S as OrbitSpace<N>>::Point, <S as OrbitSpace<N>>::Elem>;
 /// The lifted vertices of one cell.
 pub type LiftedCell<S, const N: usize> = [LiftedOf<S, N>; N];
 /// A vertex id with a lifted position.
 pub type Candidate<S, const N: usize> = (u32, LiftedOf<S, N>);
 
 /// Reusable buffers of one insertion or removal (no allocation per point).
-#[derive(Debug, Default)]
+#[derive(Debug)]
 struct Scratch<O> {
     /// Conflict cells with the query's offset in each cell's frame.
     conflict: Vec<(u32, O)>,
@@ -36,6 +36,17 @@ struct Scratch<O> {
     boundary: Vec<(u32, u8)>,
     /// New cells, parallel to `boundary`.
     created: Vec<u32>,
+}
+
+// (not derived: that would ask the group elements for a `Default`)
+impl<O> Default for Scratch<O> {
+    fn default() -> Self {
+        Scratch {
+            conflict: Vec::new(),
+            boundary: Vec::new(),
+            created: Vec::new(),
+        }
+    }
 }
 
 /// The result of inserting one point.
@@ -57,7 +68,7 @@ pub struct Engine<S: OrbitSpace<N>, const N: usize> {
     pub(crate) vpoint: Vec<u32>,
     /// Vertex → one incident cell.
     pub(crate) vcell: Vec<u32>,
-    pub(crate) tds: Tds<S::Offset, N>,
+    pub(crate) tds: Tds<S::Elem, N>,
     /// The level of the covering ladder the triangulation lives in.
     pub(crate) level: usize,
     /// `level` is the last one: the quotient itself.
@@ -72,14 +83,14 @@ pub struct Engine<S: OrbitSpace<N>, const N: usize> {
     /// The squared circumradius that makes a cell big.
     big_limit: f64,
     /// The offsets of one point's copies in the current covering.
-    copies: Vec<S::Offset>,
+    copies: Vec<S::Elem>,
     hint: u32,
     /// Where the last inserted point sits in the hint cell's frame, relative to its own
     /// offset: the next query (spatially close) starts its walk lifted by this translation,
     /// not a period away when the hint cell straddles the domain boundary.
-    hint_shift: S::Offset,
+    hint_shift: S::Elem,
     rng: SplitMix,
-    scratch: Scratch<S::Offset>,
+    scratch: Scratch<S::Elem>,
 }
 
 impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
@@ -87,6 +98,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     pub fn new(space: S) -> Self {
         let last = space.levels() - 1;
         Engine {
+            hint_shift: space.identity(),
             copies: space.covering_copies(0),
             big_limit: space.criterion_radius2(last.min(1)),
             space,
@@ -100,7 +112,6 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             big: Vec::new(),
             big_count: 0,
             hint: 0,
-            hint_shift: S::Offset::default(),
             rng: SplitMix::new(0x5eed),
             scratch: Scratch::default(),
         }
@@ -169,7 +180,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     }
 
     /// A stored cell.
-    pub fn cell(&self, c: u32) -> &Cell<S::Offset, N> {
+    pub fn cell(&self, c: u32) -> &Cell<S::Elem, N> {
         &self.tds.cells[c as usize]
     }
 
@@ -209,26 +220,26 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
 
     /// The offset that maps the frame of `d = neighbour(c, i)` onto the frame of `c`.
     #[inline(always)]
-    pub fn translation(&self, c: u32, i: usize, d: u32) -> S::Offset {
+    pub fn translation(&self, c: u32, i: usize, d: u32) -> S::Elem {
         let cc = &self.tds.cells[c as usize];
         let dc = &self.tds.cells[d as usize];
-        let zero = S::Offset::default();
-        if cc.off == [zero; N] && dc.off == [zero; N] {
-            return zero;
+        let one = self.space.identity();
+        if cc.off == [one; N] && dc.off == [one; N] {
+            return one;
         }
         let k = (i + 1) % N;
         let j = dc.index_of(cc.v[k]).expect("neighbours share a facet");
-        self.space.difference(cc.off[k], dc.off[j])
+        self.space.carry(dc.off[j], cc.off[k])
     }
 
     /// The cells incident to vertex `v`: (cell, index of `v` in it, shift from the cell's
     /// frame to the frame of the first cell, so that the star lifts as one piece).
-    pub fn star(&self, v: u32) -> Vec<(u32, usize, S::Offset)> {
+    pub fn star(&self, v: u32) -> Vec<(u32, usize, S::Elem)> {
         let c0 = self.vcell[v as usize];
         let i0 = self.tds.cells[c0 as usize]
             .index_of(v)
             .expect("vcell holds its vertex");
-        let mut star = vec![(c0, i0, S::Offset::default())];
+        let mut star = vec![(c0, i0, self.space.identity())];
         let mut next = 0;
         while next < star.len() {
             let (c, i, shift) = star[next];
@@ -237,7 +248,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 if star.iter().any(|s| s.0 == d) {
                     continue;
                 }
-                let t = self.space.compose(self.translation(c, k, d), shift);
+                let t = self.space.compose(shift, self.translation(c, k, d));
                 let j = self.tds.cells[d as usize]
                     .index_of(v)
                     .expect("a neighbour through a facet holding v holds v");
@@ -249,12 +260,12 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     }
 
     /// The neighbours of vertex `v`: each (vertex, its offset relative to `v`) once, sorted.
-    pub fn neighbours(&self, v: u32) -> Vec<(u32, S::Offset)> {
+    pub fn neighbours(&self, v: u32) -> Vec<(u32, S::Elem)> {
         let mut out = Vec::new();
         for (c, k, _) in self.star(v) {
             let cell = &self.tds.cells[c as usize];
             for j in (0..N).filter(|&j| j != k) {
-                out.push((cell.v[j], self.space.difference(cell.off[j], cell.off[k])));
+                out.push((cell.v[j], self.space.relative(cell.off[j], cell.off[k])));
             }
         }
         out.sort_unstable();
@@ -264,7 +275,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
 
     /// Gives point `p` the representative `coords`, where `coords + t·M` is its current
     /// position: every copy's star gets its offset shifted by `t`, so no cell moves.
-    pub(crate) fn move_representative(&mut self, p: u32, coords: S::Point, t: S::Offset) {
+    pub(crate) fn move_representative(&mut self, p: u32, coords: S::Point, t: S::Elem) {
         // the point itself once 1-sheeted; its copies `p·S … p·S+S−1` in the covering
         let copies = self.space.sheets(self.level) as u32;
         for v in p * copies..(p + 1) * copies {
@@ -287,7 +298,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             p
         } else {
             let sheets = self.space.sheets(self.level) as u32;
-            p * sheets + self.space.sheet_of(S::Offset::default(), self.level) as u32
+            p * sheets + self.space.sheet_of(self.space.identity(), self.level) as u32
         }
     }
 
@@ -297,7 +308,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     }
 
     /// Creates a cell, normalizing its offsets, and keeps the criterion bookkeeping.
-    fn make_cell(&mut self, v: [u32; N], mut off: [S::Offset; N]) -> u32 {
+    fn make_cell(&mut self, v: [u32; N], mut off: [S::Elem; N]) -> u32 {
         self.space.normalize(&mut off, self.level);
         let id = self.tds.create(Cell::new(v, off));
         if !self.guaranteed {
@@ -374,7 +385,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
 
     /// A live cell to start a walk from, and the translation to apply to a query near the
     /// last inserted point.
-    fn start_cell(&self) -> (u32, S::Offset) {
+    fn start_cell(&self) -> (u32, S::Elem) {
         if self.hint != NONE
             && (self.hint as usize) < self.tds.cells.len()
             && self.tds.is_alive(self.hint)
@@ -383,7 +394,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         } else {
             (
                 self.tds.ids().next().expect("a non-empty triangulation"),
-                S::Offset::default(),
+                self.space.identity(),
             )
         }
     }

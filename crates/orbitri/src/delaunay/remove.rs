@@ -21,9 +21,9 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     pub(crate) fn remove_vertex(&mut self, v: u32) -> Result<(), RemoveError> {
         debug_assert!(self.one_sheeted);
         let star = self.star(v);
-        let shifted = |e: &Self, c: u32, shift: S::Offset| -> LiftedCell<S, N> {
+        let shifted = |e: &Self, c: u32, shift: S::Elem| -> LiftedCell<S, N> {
             e.lifted_cell(c)
-                .map(|(p, o)| (p, e.space.compose(o, shift)))
+                .map(|(p, o)| (p, e.space.compose(shift, o)))
         };
         let mut hole: Vec<Candidate<S, N>> = Vec::new();
         let mut seeds = Vec::with_capacity(star.len());
@@ -72,19 +72,19 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     fn removal_keeps_simplicial(
         &mut self,
         star: &[u32],
-        cells: &[Wrapped<S::Point, S::Offset, N>],
+        cells: &[Wrapped<S::Point, S::Elem, N>],
     ) -> bool {
         let mut hole: Vec<u32> = cells.iter().flat_map(|w| w.vids).collect();
         hole.sort_unstable();
         hole.dedup();
-        let mut edges: Vec<(u32, S::Offset)> = Vec::new();
+        let mut edges: Vec<(u32, S::Elem)> = Vec::new();
         let mut stack: Vec<u32> = Vec::new();
         for &a in &hole {
             edges.clear();
             for w in cells {
                 if let Some(i) = w.vids.iter().position(|&x| x == a) {
                     for j in (0..N).filter(|&j| j != i) {
-                        edges.push((w.vids[j], self.space.difference(w.arr[j].1, w.arr[i].1)));
+                        edges.push((w.vids[j], self.space.relative(w.arr[j].1, w.arr[i].1)));
                     }
                 }
             }
@@ -98,7 +98,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 let i = cell.index_of(a).expect("the star of a vertex holds it");
                 for k in (0..N).filter(|&k| k != i) {
                     if !star.contains(&c) {
-                        edges.push((cell.v[k], self.space.difference(cell.off[k], cell.off[i])));
+                        edges.push((cell.v[k], self.space.relative(cell.off[k], cell.off[i])));
                     }
                     let d = cell.n[k];
                     if self.tds.stamp(d) != mark {

@@ -51,7 +51,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                     if kk == j {
                         return bad(format!("cells {c} and {d}: facet mismatch"));
                     }
-                    let tk = self.space.difference(cell.off[k], dc.off[kk]);
+                    let tk = self.space.carry(dc.off[kk], cell.off[k]);
                     if *t.get_or_insert(tk) != tk {
                         return bad(format!(
                             "cells {c} and {d}: inconsistent offsets across the shared facet"
@@ -59,7 +59,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                     }
                 }
                 let q = self.lifted(d, j);
-                let q = (q.0, self.space.compose(q.1, t.unwrap()));
+                let q = (q.0, self.space.compose(t.unwrap(), q.1));
                 if self.space.in_sphere(&self.lifted_cell(c), q) == Sign::Positive {
                     return bad(format!(
                         "cell {c} is not locally Delaunay: vertex {} of cell {d} is inside",
@@ -76,18 +76,19 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 return bad(format!("vertex {v} has no incident cell"));
             }
         }
-        // Euler characteristic 0 (torus, closed flat 3-manifold). Every facet is shared by
-        // two cells (checked above), so F = 2C in 3D and the faces are the cells in 2D: in
-        // both, χ = V − E + C. Edges are counted from each vertex's star, towards larger ids (in
+        // The Euler characteristic of the stored complex: the space's, times the sheets of a
+        // covering. Every facet is shared by two cells (checked above), so F = 2C in 3D and
+        // the faces are the cells in 2D: in both, χ = V − E + C. Edges are counted from each vertex's star, towards larger ids (in
         // the covering, ids are unique per copy, so an edge is one (vertex, vertex) pair).
         let edges: usize = (0..self.vcell.len() as u32)
             .map(|v| self.neighbours(v).iter().filter(|w| w.0 > v).count())
             .sum();
         let counts = [self.vcell.len(), edges, self.tds.len()];
         let euler = counts[0] as i64 - counts[1] as i64 + counts[2] as i64;
-        if euler != 0 {
+        let expected = self.sheets() as i64 * self.space.euler_characteristic();
+        if euler != expected {
             return bad(format!(
-                "Euler characteristic {euler}, expected 0 (V, E, C = {:?})",
+                "Euler characteristic {euler}, expected {expected} (V, E, C = {:?})",
                 counts
             ));
         }

@@ -51,7 +51,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// The Delaunay apex for an open facet among `cands` (vertex id, lifted point).
     fn pivot(
         &self,
-        f: &Open<S::Point, S::Offset, N>,
+        f: &Open<S::Point, S::Elem, N>,
         cands: &[Candidate<S, N>],
     ) -> Option<(u32, LiftedCell<S, N>)> {
         let want = if f.toward {
@@ -91,9 +91,9 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         &self,
         seeds: Vec<Seed<S, N>>,
         mut candidates: impl FnMut(&LiftedCell<S, N>, usize) -> Vec<Candidate<S, N>>,
-        mut first: Vec<Wrapped<S::Point, S::Offset, N>>,
-    ) -> Option<Vec<Wrapped<S::Point, S::Offset, N>>> {
-        let mut open: HashMap<[u32; N], Open<S::Point, S::Offset, N>> = HashMap::new();
+        mut first: Vec<Wrapped<S::Point, S::Elem, N>>,
+    ) -> Option<Vec<Wrapped<S::Point, S::Elem, N>>> {
+        let mut open: HashMap<[u32; N], Open<S::Point, S::Elem, N>> = HashMap::new();
         let mut queue: Vec<[u32; N]> = Vec::new();
         for (vids, arr, idx, toward, owner) in seeds {
             let key = facet_key(&vids, idx);
@@ -154,7 +154,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     }
 
     /// Creates the wrapped cells and links them; returns their ids.
-    pub(super) fn commit(&mut self, cells: &[Wrapped<S::Point, S::Offset, N>]) -> Vec<u32> {
+    pub(super) fn commit(&mut self, cells: &[Wrapped<S::Point, S::Elem, N>]) -> Vec<u32> {
         let ids: Vec<u32> = cells
             .iter()
             .map(|w| self.make_cell(w.vids, w.arr.map(|(_, o)| o)))
@@ -171,7 +171,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             self.attach(id);
         }
         self.hint = ids[0];
-        self.hint_shift = S::Offset::default();
+        self.hint_shift = self.space.identity();
         ids
     }
 
@@ -183,7 +183,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         a: Candidate<S, N>,
         cands: &[Candidate<S, N>],
         max_r2: f64,
-    ) -> Option<Wrapped<S::Point, S::Offset, N>> {
+    ) -> Option<Wrapped<S::Point, S::Elem, N>> {
         let others: Vec<Candidate<S, N>> = cands.iter().copied().filter(|c| c.0 != a.0).collect();
         let k = others.len();
         let mut pick = vec![0usize; N - 1];
@@ -244,7 +244,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     }
 
     /// Seeds for wrapping outward from a first cell: its facets, owned by itself.
-    pub(super) fn seeds_of(w: &Wrapped<S::Point, S::Offset, N>) -> Vec<Seed<S, N>> {
+    pub(super) fn seeds_of(w: &Wrapped<S::Point, S::Elem, N>) -> Vec<Seed<S, N>> {
         (0..N)
             .map(|m| (w.vids, w.arr, m, false, Owner::New(0, m)))
             .collect()

@@ -417,26 +417,46 @@ fn filtered_center<const D: usize>(
 /// The orbit-space methods that do not depend on the dimension, for an `impl OrbitSpace<N>
 /// for FlatTorus<D>` block.
 macro_rules! flat_torus_plugin {
-    ($n:literal) => {
+    ($n:literal, $d:literal) => {
         #[inline]
-        fn compose(&self, a: Self::Offset, b: Self::Offset) -> Self::Offset {
+        fn identity(&self) -> Self::Elem {
+            [0; $d]
+        }
+
+        #[inline]
+        fn compose(&self, a: Self::Elem, b: Self::Elem) -> Self::Elem {
             Self::add(a, b)
         }
 
         #[inline]
-        fn difference(&self, a: Self::Offset, b: Self::Offset) -> Self::Offset {
+        fn inverse(&self, a: Self::Elem) -> Self::Elem {
+            Self::sub([0; $d], a)
+        }
+
+        // the group is abelian: both differences are one subtraction
+        #[inline]
+        fn relative(&self, a: Self::Elem, b: Self::Elem) -> Self::Elem {
             Self::sub(a, b)
+        }
+
+        #[inline]
+        fn carry(&self, from: Self::Elem, to: Self::Elem) -> Self::Elem {
+            Self::sub(to, from)
+        }
+
+        fn euler_characteristic(&self) -> i64 {
+            0
         }
 
         fn cospherical(
             &self,
-            s: &[(Self::Point, Self::Offset); $n],
-            q: (Self::Point, Self::Offset),
+            s: &[(Self::Point, Self::Elem); $n],
+            q: (Self::Point, Self::Elem),
         ) -> bool {
             self.in_sphere_raw(s, q) == crate::predicates::Sign::Zero
         }
 
-        fn coincide(&self, a: (Self::Point, Self::Offset), b: (Self::Point, Self::Offset)) -> bool {
+        fn coincide(&self, a: (Self::Point, Self::Elem), b: (Self::Point, Self::Elem)) -> bool {
             self.coincide_lifted(a, b)
         }
 
@@ -452,12 +472,12 @@ macro_rules! flat_torus_plugin {
             4.0 * self.criterion_r2(self.ladder().len() - 1)
         }
 
-        fn covering_copies(&self, level: usize) -> Vec<Self::Offset> {
+        fn covering_copies(&self, level: usize) -> Vec<Self::Elem> {
             self.copies(level)
         }
 
         #[inline]
-        fn normalize(&self, off: &mut [Self::Offset; $n], level: usize) {
+        fn normalize(&self, off: &mut [Self::Elem; $n], level: usize) {
             self.normalize_offsets(off, level)
         }
 
@@ -466,16 +486,16 @@ macro_rules! flat_torus_plugin {
         }
 
         #[inline]
-        fn sheet_of(&self, o: Self::Offset, level: usize) -> usize {
+        fn sheet_of(&self, o: Self::Elem, level: usize) -> usize {
             self.sheet(o, level)
         }
 
         fn near(
             &self,
-            z: (Self::Point, Self::Offset),
+            z: (Self::Point, Self::Elem),
             pts: &[Self::Point],
             radius: f64,
-            out: &mut Vec<(u32, Self::Offset)>,
+            out: &mut Vec<(u32, Self::Elem)>,
         ) {
             self.near_copies(z, pts, radius, out)
         }
@@ -490,3 +510,33 @@ macro_rules! flat_torus_plugin {
     };
 }
 pub(super) use flat_torus_plugin;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::space::OrbitSpace;
+
+    /// The torus's one-subtraction `relative` and `carry` are the group's `b⁻¹∘a` and
+    /// `to∘from⁻¹`, and both are invariant under translating by a common element, as the
+    /// engine assumes of every space.
+    #[test]
+    fn group_differences_follow_the_group_law() {
+        let t = FlatTorus3::cuboid([1.0; 3]).unwrap();
+        let elems: Vec<[i8; 3]> = vec![[0, 0, 0], [1, -2, 3], [-4, 0, 1], [2, 2, -2]];
+        for &a in &elems {
+            assert_eq!(t.compose(a, t.identity()), a);
+            assert_eq!(t.compose(a, t.inverse(a)), t.identity());
+            for &b in &elems {
+                let rel = t.relative(a, b);
+                assert_eq!(rel, t.compose(t.inverse(b), a));
+                assert_eq!(t.carry(b, a), t.compose(a, t.inverse(b)));
+                // carrying b onto a, then applying it to b, gives a
+                assert_eq!(t.compose(t.carry(b, a), b), a);
+                for &h in &elems {
+                    assert_eq!(t.relative(t.compose(h, a), t.compose(h, b)), rel);
+                }
+            }
+        }
+        assert_eq!(t.euler_characteristic(), 0);
+    }
+}

@@ -54,9 +54,9 @@ fn center_polynomials(d: &[[f64; 2]; 2], minus: fn(f64, f64) -> f64) -> ([f64; 2
 
 impl OrbitSpace<3> for FlatTorus<2> {
     type Point = [f64; 2];
-    type Offset = [i8; 2];
+    type Elem = [i8; 2];
 
-    flat_torus_plugin!(3);
+    flat_torus_plugin!(3, 2);
 
     #[inline(always)]
     fn orient(&self, s: &[L2; 3]) -> Sign {

@@ -69,9 +69,9 @@ fn center_polynomials(d: &[[f64; 3]; 3], minus: fn(f64, f64) -> f64) -> ([f64; 3
 
 impl OrbitSpace<4> for FlatTorus<3> {
     type Point = [f64; 3];
-    type Offset = [i8; 3];
+    type Elem = [i8; 3];
 
-    flat_torus_plugin!(4);
+    flat_torus_plugin!(4, 3);
 
     #[inline(always)]
     fn orient(&self, s: &[L3; 4]) -> Sign {

@@ -25,44 +25,64 @@ pub trait OrbitSpace<const N: usize>: Sync + Send {
     /// A point of the fundamental domain.
     type Point: Copy + Debug + PartialEq + Send + Sync;
     /// A group element, as stored per cell vertex (flat torus: an integer offset vector).
-    type Offset: Copy + Debug + Eq + Hash + Ord + Default + Send + Sync;
+    /// It acts on points from the left: a cell vertex `(p, g)` lies at `g·p`, and
+    /// translating a cell by `h` makes its elements `h∘g`.
+    type Elem: Copy + Debug + Eq + Hash + Ord + Send + Sync;
 
-    /// `a + b` in the group.
-    fn compose(&self, a: Self::Offset, b: Self::Offset) -> Self::Offset;
-    /// `a − b` in the group.
-    fn difference(&self, a: Self::Offset, b: Self::Offset) -> Self::Offset;
+    /// The identity element.
+    fn identity(&self) -> Self::Elem;
+    /// `a∘b`: first `b`, then `a`.
+    fn compose(&self, a: Self::Elem, b: Self::Elem) -> Self::Elem;
+    /// `a⁻¹`.
+    fn inverse(&self, a: Self::Elem) -> Self::Elem;
+    /// `b⁻¹∘a`: the element `a` seen from the frame of `b` (a vertex's element relative to
+    /// another vertex of the same cell; a query carried into a neighbour's frame). Invariant
+    /// under translating both by the same element.
+    #[inline]
+    fn relative(&self, a: Self::Elem, b: Self::Elem) -> Self::Elem {
+        self.compose(self.inverse(b), a)
+    }
+    /// `to∘from⁻¹`: the element that carries the frame of `from` onto the frame of `to`
+    /// (the translation between two cells sharing a vertex).
+    #[inline]
+    fn carry(&self, from: Self::Elem, to: Self::Elem) -> Self::Elem {
+        self.compose(to, self.inverse(from))
+    }
+    /// The Euler characteristic of the space (0 for every closed flat manifold), which
+    /// `is_valid` checks.
+    fn euler_characteristic(&self) -> i64;
     /// Exact orientation of the lifted simplex.
-    fn orient(&self, s: &[Lifted<Self::Point, Self::Offset>; N]) -> Sign;
+    fn orient(&self, s: &[Lifted<Self::Point, Self::Elem>; N]) -> Sign;
     /// Exact, symbolically perturbed in-sphere test: `Positive` when `q` is inside the
     /// circumsphere of the positively oriented `s`, never `Zero` for a point distinct from
     /// the vertices. The perturbation depends only on the lifted positions, so every
     /// periodic copy of a configuration gets the same answer.
     fn in_sphere(
         &self,
-        s: &[Lifted<Self::Point, Self::Offset>; N],
-        q: Lifted<Self::Point, Self::Offset>,
+        s: &[Lifted<Self::Point, Self::Elem>; N],
+        q: Lifted<Self::Point, Self::Elem>,
     ) -> Sign;
     /// Exact test whether `q` lies on the circumsphere of `s` (no perturbation): the
     /// Voronoi vertices of such cells coincide.
     fn cospherical(
         &self,
-        s: &[Lifted<Self::Point, Self::Offset>; N],
-        q: Lifted<Self::Point, Self::Offset>,
+        s: &[Lifted<Self::Point, Self::Elem>; N],
+        q: Lifted<Self::Point, Self::Elem>,
     ) -> bool;
     /// Exact test whether two lifted points coincide.
     fn coincide(
         &self,
-        a: Lifted<Self::Point, Self::Offset>,
-        b: Lifted<Self::Point, Self::Offset>,
+        a: Lifted<Self::Point, Self::Elem>,
+        b: Lifted<Self::Point, Self::Elem>,
     ) -> bool;
     /// Squared circumradius, to a relative accuracy of about `2^-43` (infinite for a flat
     /// simplex): from [`OrbitSpace::circumcenter`].
-    fn circumradius2(&self, s: &[Lifted<Self::Point, Self::Offset>; N]) -> f64;
+    fn circumradius2(&self, s: &[Lifted<Self::Point, Self::Elem>; N]) -> f64;
     /// The circumcenter of the lifted simplex relative to its vertex 0, in Cartesian
     /// coordinates, certified: a floating-point evaluation whose error bound is below
     /// `2^-44` of its magnitude (and of the simplex's extent) is accepted, otherwise it is
     /// computed exactly and rounded. Infinite coordinates for a flat simplex.
-    fn circumcenter(&self, s: &[Lifted<Self::Point, Self::Offset>; N]) -> Self::Point;
+    fn circumcenter(&self, s: &[Lifted<Self::Point, Self::Elem>; N]) -> Self::Point;
     /// Number of levels of the covering ladder: level 0 is a covering in which every
     /// non-empty point set has a Delaunay triangulation, each next level has fewer sheets, and
     /// the last is the orbit space itself (1 sheet).
@@ -75,24 +95,24 @@ pub trait OrbitSpace<const N: usize>: Sync + Send {
     /// a safety margin: a conflict region made of such balls lifts consistently.
     fn single_lift_radius2(&self) -> f64;
     /// The offsets of the copies of one point in the covering of `level` (one per sheet).
-    fn covering_copies(&self, level: usize) -> Vec<Self::Offset>;
+    fn covering_copies(&self, level: usize) -> Vec<Self::Elem>;
     /// Translates a cell's offsets by a group element of the space of `level` into canonical
     /// form: cells that differ by such a translation get equal offsets.
-    fn normalize(&self, off: &mut [Self::Offset; N], level: usize);
+    fn normalize(&self, off: &mut [Self::Elem; N], level: usize);
     /// A dummy point set whose Delaunay triangulation satisfies the switch criterion.
     fn dummy_points(&self) -> Vec<Self::Point>;
     /// Number of sheets of the covering of `level` (`covering_copies(level).len()`).
     fn sheets(&self, level: usize) -> usize;
     /// Index of the sheet of `level` holding a lifted copy with offset `o`.
-    fn sheet_of(&self, o: Self::Offset, level: usize) -> usize;
+    fn sheet_of(&self, o: Self::Elem, level: usize) -> usize;
     /// Appends to `out` every lifted copy `(i, o)` of `pts[i]` whose position is within
     /// `radius` of the lifted point `z` (generous: a copy slightly farther may be included).
     fn near(
         &self,
-        z: Lifted<Self::Point, Self::Offset>,
+        z: Lifted<Self::Point, Self::Elem>,
         pts: &[Self::Point],
         radius: f64,
-        out: &mut Vec<(u32, Self::Offset)>,
+        out: &mut Vec<(u32, Self::Elem)>,
     );
     /// An upper bound on the length of a Delaunay edge: at level 0 for any non-empty point
     /// set, at a later level under that level's criterion.

@@ -15,7 +15,7 @@ pub struct Cell<O, const N: usize> {
     stamp: u32,
 }
 
-impl<O: Copy + Default, const N: usize> Cell<O, N> {
+impl<O: Copy, const N: usize> Cell<O, N> {
     /// A cell with no neighbours yet.
     pub fn new(v: [u32; N], off: [O; N]) -> Self {
         Cell {
@@ -47,7 +47,7 @@ pub struct Tds<O, const N: usize> {
     generation: u32,
 }
 
-impl<O: Copy + Default, const N: usize> Tds<O, N> {
+impl<O: Copy, const N: usize> Tds<O, N> {
     /// An empty complex.
     pub fn new() -> Self {
         Tds {
