@@ -114,12 +114,14 @@ fn root(parent: &mut [usize], mut x: usize) -> usize {
 
 /// What every Voronoi cell reads from the triangulation, computed once: each stored cell's
 /// circumcenter (certified, relative to its lifted vertex 0, in the lattice's internal
-/// frame), the class of each cell under "adjacent and cospherical" (one Voronoi vertex per
-/// class), and the cells around each vertex.
+/// frame), the facets across which two cells share their circumsphere (their Voronoi
+/// vertices coincide), and the cells around each vertex.
 struct Duals<const D: usize> {
     /// Indexed by stored cell id.
     center: Vec<[f64; D]>,
-    class: Vec<u32>,
+    /// Bit `x` of `cospherical[c]`: cell `c` and its neighbour across facet `x` have one
+    /// circumsphere (decided exactly), so they give one Voronoi vertex.
+    cospherical: Vec<u8>,
     /// The incident (cell, slot) pairs of vertex `v`: `incident[start[v]..start[v + 1]]`.
     start: Vec<u32>,
     incident: Vec<(u32, u8)>,
@@ -245,7 +247,7 @@ where
             return Err(Error::Interrupted);
         }
         // adjacent cells with one circumsphere: decided exactly, each facet once
-        let merges: Vec<(u32, u32)> = ids
+        let merges: Vec<(u32, usize, u32, usize)> = ids
             .par_iter()
             .flat_map_iter(|&c| {
                 let cell = e.cell(c);
@@ -264,16 +266,15 @@ where
                         e.points()[e.point_of(dc.v[y]) as usize],
                         torus.compose(shift, dc.off[y]),
                     );
-                    torus.cospherical(&lifted, opposite).then_some((c, d))
+                    torus.cospherical(&lifted, opposite).then_some((c, x, d, y))
                 })
             })
             .collect();
-        let mut parent: Vec<usize> = (0..slots).collect();
-        for (c, d) in merges {
-            let (a, b) = (root(&mut parent, c as usize), root(&mut parent, d as usize));
-            parent[a.max(b)] = a.min(b);
+        let mut cospherical = vec![0u8; slots];
+        for (c, x, d, y) in merges {
+            cospherical[c as usize] |= 1 << x;
+            cospherical[d as usize] |= 1 << y;
         }
-        let class = (0..slots).map(|c| root(&mut parent, c) as u32).collect();
         // incidence lists by counting sort
         let vertices = e.number_of_vertices();
         let mut start = vec![0u32; vertices + 1];
@@ -295,7 +296,7 @@ where
         }
         Ok(Duals {
             center,
-            class,
+            cospherical,
             start,
             incident,
         })
@@ -310,25 +311,38 @@ where
             &duals.incident[duals.start[v as usize] as usize..duals.start[v as usize + 1] as usize];
         let lattice = torus.lattice();
         let position = e.points()[p as usize];
-        // one Voronoi vertex per class, relative to the point in the frame of its cells
-        let mut class_ids: Vec<u32> = Vec::with_capacity(star.len());
+        // one Voronoi vertex per group of star cells joined, through facets at the point, by
+        // a shared circumsphere (so in one lift around the point: a sphere met again around
+        // the torus at another lift of the point is another vertex)
+        let mut parent: Vec<usize> = (0..star.len()).collect();
+        for (s, &(c, k)) in star.iter().enumerate() {
+            let cell = e.cell(c);
+            for x in
+                (0..N).filter(|&x| x != k as usize && duals.cospherical[c as usize] >> x & 1 == 1)
+            {
+                let d = cell.n[x];
+                let t = star
+                    .iter()
+                    .position(|&(sc, _)| sc == d)
+                    .expect("a neighbour across a facet at the point is in its star");
+                let (a, b) = (root(&mut parent, s), root(&mut parent, t));
+                parent[a.max(b)] = a.min(b);
+            }
+        }
         let mut vertices: Vec<[f64; D]> = Vec::with_capacity(star.len());
-        let vertex_of: Vec<u32> = star
-            .iter()
-            .map(|&(c, k)| {
-                let class = duals.class[c as usize];
-                match class_ids.iter().position(|&x| x == class) {
-                    Some(i) => i as u32,
-                    None => {
-                        // the center is relative to the cell's vertex 0
-                        let to_point =
-                            torus.lifted_difference(e.lifted(c, k as usize), e.lifted(c, 0));
-                        let z = duals.center[c as usize];
-                        class_ids.push(class);
-                        vertices.push(std::array::from_fn(|x| z[x] - to_point[x]));
-                        vertices.len() as u32 - 1
-                    }
+        let mut vertex_of_root = vec![u32::MAX; star.len()];
+        let vertex_of: Vec<u32> = (0..star.len())
+            .map(|s| {
+                let r = root(&mut parent, s);
+                if vertex_of_root[r] == u32::MAX {
+                    let (c, k) = star[r];
+                    // the center is relative to the cell's vertex 0
+                    let to_point = torus.lifted_difference(e.lifted(c, k as usize), e.lifted(c, 0));
+                    let z = duals.center[c as usize];
+                    vertices.push(std::array::from_fn(|x| z[x] - to_point[x]));
+                    vertex_of_root[r] = vertices.len() as u32 - 1;
                 }
+                vertex_of_root[r]
             })
             .collect();
         // faces: the ring of star cells around each Delaunay edge at the point
@@ -473,10 +487,10 @@ fn order_polygon<const D: usize>(vertices: &mut Vec<[f64; D]>, faces: &mut [Voro
             ends[v as usize].push(f);
         }
     }
-    assert!(
-        n == faces.len() && ends.iter().all(|e| e.len() == 2),
-        "a Voronoi polygon is a cycle of edges"
-    );
+    if n < 2 || n != faces.len() || ends.iter().any(|e| e.len() != 2) {
+        debug_assert!(false, "a Voronoi polygon is a cycle of edges");
+        return;
+    }
     // walk the cycle from vertex 0 along face 0
     let mut cycle = Vec::with_capacity(n);
     let (mut v, mut f) = (0usize, ends[0][0]);

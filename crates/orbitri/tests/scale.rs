@@ -448,3 +448,27 @@ proptest! {
         check_voronoi(&build2(1.0, &pts2));
     }
 }
+
+/// A lattice near the largest doubles: its dummy points stay in the internal frame (they
+/// overflowed on a trip through user units).
+#[test]
+fn dummy_points_of_a_lattice_near_the_largest_doubles() {
+    let m = [[1.5e308, 0.0], [1e308, 1.5e308]];
+    let torus = FlatTorus2::new(Lattice::new(m).unwrap());
+    let mut s = 3u64;
+    let pts: Vec<[f64; 2]> = (0..1500)
+        .map(|_| {
+            let mut next = || {
+                s = s.wrapping_mul(6364136223846793005).wrapping_add(1);
+                (s >> 11) as f64 / (1u64 << 53) as f64
+            };
+            let (f0, f1) = (next(), 0.2 * next());
+            [f0 * m[0][0] + f1 * m[1][0], f1 * m[1][1]]
+        })
+        .collect();
+    // 1500 points start from the dummy grid (the points fill a fifth of the domain, so the
+    // build then falls back to the covering: both paths must hold)
+    let tri = PeriodicDelaunay2::build(torus, &pts).unwrap();
+    assert!(tri.is_valid().is_ok());
+    assert_eq!(tri.number_of_vertices(), 1500);
+}

@@ -407,7 +407,8 @@ fn filtered_center<const D: usize>(
         x[k] = num[k] / den;
         let q = x[k].abs() * (1.0 + U);
         let bound = 2.0 * U * q + (err(num0[k], num1[k]) + q * err_den) / (den.abs() - err_den);
-        if bound.is_nan() || bound > CENTER_TOLERANCE * x[k].abs().max(extent) {
+        if !x[k].is_finite() || bound.is_nan() || bound > CENTER_TOLERANCE * x[k].abs().max(extent)
+        {
             return None;
         }
     }

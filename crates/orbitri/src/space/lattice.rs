@@ -256,8 +256,9 @@ impl<const D: usize> Lattice<D> {
         self.measure_to_user(self.volume, D as i32)
     }
 
-    /// Ok when the domain volume is a normal double, so that Voronoi volumes in the user's
-    /// units can be represented; the typed error otherwise.
+    /// Ok when the domain volume is a normal double, so that the Voronoi volumes, which sum
+    /// to it, can be represented in the user's units (a cell far smaller than the domain may
+    /// still be subnormal); the typed error otherwise.
     pub fn check_volume_representable(&self) -> Result<()> {
         if self.volume().is_normal() {
             Ok(())
@@ -508,11 +509,8 @@ impl<const D: usize> Lattice<D> {
                 let jitter = 0.02 * (2.0 * rng.unit() - 1.0);
                 f[i] = (g as f64 + 0.5 + jitter) / k[i] as f64;
             }
-            out.push(
-                self.wrap_in(self.cartesian(&f))
-                    .expect("a fractional point wraps")
-                    .0,
-            );
+            // inside the domain by construction (f ∈ (0, 1)): no wrap, no trip to user units
+            out.push(self.cartesian_in(&f));
         }
         out
     }
