@@ -265,3 +265,13 @@ def test_voronoi_of_nearly_coincident_points_is_finite_and_sums():
     assert np.all(np.isfinite(vor.volumes)) and np.all(vor.volumes >= 0)
     first = np.unique(orbitri.PeriodicDelaunay(np.vstack([pts, shifted, ulp]), [1.0] * 3).duplicates)
     assert abs(vor.volumes[first].sum() - 1.0) < 1e-12
+
+
+def test_insert_of_a_point_out_of_reach_is_a_value_error_and_changes_nothing():
+    box = np.array([[1.0, 0.0, 0.0], [0.3, 0.9, 0.0], [-0.2, 0.2, 1.1]])
+    tri = orbitri.PeriodicDelaunay(np.random.default_rng(2).random((50, 3)), box)
+    cells = _canonical(tri.simplices, tri.offsets)
+    with pytest.raises(ValueError, match=r"^point 1: .* too far from the domain"):
+        tri.insert([[0.5, 0.5, 0.5], [1e300, 0.0, 0.0]])
+    assert tri.number_of_input_points == 50
+    assert _canonical(tri.simplices, tri.offsets) == cells

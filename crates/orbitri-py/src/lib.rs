@@ -193,36 +193,26 @@ where
     })
 }
 
-/// The first non-finite coordinate of row-major points of dimension `d`, as the library
-/// names it, with the row in the batch as the point.
-fn check_finite(flat: &[f64], d: usize) -> PyResult<()> {
-    match flat.iter().position(|v| !v.is_finite()) {
-        None => Ok(()),
-        Some(k) => Err(value_error(orbitri::Error::NonFiniteCoordinate {
-            index: k / d,
-            axis: k % d,
-            value: flat[k],
-        })),
-    }
-}
-
-/// Inserts row-major points of dimension `D` (all finite); their input ids.
+/// Inserts row-major points of dimension `D`, all or nothing (the library checks every row
+/// first); their input ids.
 fn insert_all<const D: usize, const N: usize>(
     t: &mut PeriodicDelaunay<D, N>,
     flat: &[f64],
-) -> Vec<i64>
+) -> orbitri::Result<Vec<i64>>
 where
     FlatTorus<D>: Torus<D, N>,
 {
-    flat.chunks_exact(D)
-        .map(|q| {
-            let r = t
-                .insert(std::array::from_fn(|c| q[c]))
-                .expect("checked finite");
+    let points: Vec<[f64; D]> = flat
+        .chunks_exact(D)
+        .map(|q| std::array::from_fn(|c| q[c]))
+        .collect();
+    Ok(t.insert_all(&points)?
+        .into_iter()
+        .map(|r| {
             let (orbitri::Inserted::New(v) | orbitri::Inserted::Duplicate(v)) = r;
             i64::from(t.input_of_vertex(v))
         })
-        .collect()
+        .collect())
 }
 
 fn simplices<const D: usize, const N: usize>(
@@ -389,10 +379,11 @@ impl Triangulation {
             )));
         }
         let flat: Vec<f64> = p.iter().copied().collect();
-        check_finite(&flat, d)?;
         let mut guard = self.write(py)?;
         let tri = &mut *guard;
-        let ids = py.detach(|| with_tri!(tri, t => insert_all(t, &flat)));
+        let ids = py
+            .detach(|| with_tri!(tri, t => insert_all(t, &flat)))
+            .map_err(value_error)?;
         self.generation.fetch_add(1, Ordering::AcqRel);
         Ok(Array1::from(ids).into_pyarray(py))
     }

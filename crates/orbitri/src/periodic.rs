@@ -238,23 +238,28 @@ where
     /// lattice translation, which the offsets of the point's star absorb.
     fn represent_first_occurrences(&mut self, wrapped: &[[f64; D]]) {
         for p in 0..self.point_input.len() {
-            let want = wrapped[self.point_input[p] as usize];
-            let have = self.engine.points()[p];
-            if want == have {
-                continue;
-            }
-            // want + t·M == have for an integer t: found approximately, confirmed exactly
-            let d: [f64; D] = std::array::from_fn(|c| have[c] - want[c]);
-            let t = self
-                .space()
-                .lattice()
-                .fractional_in(&d)
-                .map(|x| x.round() as i8);
-            let exact = self.space().coincide((want, t), (have, [0; D]));
-            debug_assert!(exact, "a duplicate is an exact lattice translate");
-            if exact {
-                self.engine.move_representative(p as u32, want, t);
-            }
+            self.represent(p as u32, wrapped[self.point_input[p] as usize]);
+        }
+    }
+
+    /// Gives point `p` the wrapped coordinates `want` of its first occurrence, when they
+    /// differ from the current ones by an exact lattice translation.
+    fn represent(&mut self, p: u32, want: [f64; D]) {
+        let have = self.engine.points()[p as usize];
+        if want == have {
+            return;
+        }
+        // want + t·M == have for an integer t: found approximately, confirmed exactly
+        let d: [f64; D] = std::array::from_fn(|c| have[c] - want[c]);
+        let t = self
+            .space()
+            .lattice()
+            .fractional_in(&d)
+            .map(|x| x.round() as i8);
+        let exact = self.space().coincide((want, t), (have, [0; D]));
+        debug_assert!(exact, "a duplicate is an exact lattice translate");
+        if exact {
+            self.engine.move_representative(p, want, t);
         }
     }
 
@@ -330,6 +335,43 @@ where
         self.wrapped += moved as usize;
         self.input_point.push(NONE);
         Ok(self.insert_wrapped(i, w))
+    }
+
+    /// Inserts a batch of points, all or nothing: every point is checked and wrapped first,
+    /// and an error, which names the point by its row in `points`, leaves the triangulation
+    /// unchanged. The batch then goes in by BRIO + Hilbert order, so that each walk starts
+    /// next to its target whatever the order of `points` (inserting points one by one in
+    /// random order walks across the triangulation each time). Input ids follow the order of
+    /// `points`, and a point met several times keeps the coordinates of its first
+    /// occurrence, as in [`Self::build`]. Returns, per point, the vertex (point index) it
+    /// became or coincides with.
+    pub fn insert_all(&mut self, points: &[[f64; D]]) -> Result<Vec<Inserted>> {
+        let internal: Vec<([f64; D], bool)> = points
+            .iter()
+            .enumerate()
+            .map(|(row, p)| internal_point(self.space(), row, p))
+            .collect::<Result<_>>()?;
+        let first = self.input_point.len();
+        self.input_point.resize(first + points.len(), NONE);
+        let keys: Vec<u64> = internal
+            .iter()
+            .map(|(w, _)| self.space().spatial_key(w))
+            .collect();
+        let order = crate::sort::brio_order(&keys, BuildOptions::default().seed ^ first as u64);
+        let mut out = vec![Inserted::New(0); points.len()];
+        for &k in &order {
+            let (w, moved) = internal[k as usize];
+            self.wrapped += moved as usize;
+            out[k as usize] = self.insert_wrapped(first + k as usize, w);
+        }
+        // a duplicate inserted before its first occurrence lent the point its coordinates
+        for (k, r) in out.iter().enumerate() {
+            let (Inserted::New(p) | Inserted::Duplicate(p)) = *r;
+            if self.point_input[p as usize] as usize == first + k {
+                self.represent(p, internal[k].0);
+            }
+        }
+        Ok(out)
     }
 
     /// The orbit space.
