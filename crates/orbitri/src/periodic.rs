@@ -127,6 +127,35 @@ fn internal_point<const D: usize>(
         })
 }
 
+/// Every point of `points` in the internal frame, wrapped (an error names the first bad
+/// one by its index in `points`), and how many wrapping moved.
+fn internal_points<const D: usize>(
+    space: &FlatTorus<D>,
+    points: &[[f64; D]],
+) -> Result<(Vec<[f64; D]>, usize)> {
+    let mut out = Vec::with_capacity(points.len());
+    let mut moved = 0;
+    for (i, p) in points.iter().enumerate() {
+        let (w, m) = internal_point(space, i, p)?;
+        moved += m as usize;
+        out.push(w);
+    }
+    Ok((out, moved))
+}
+
+/// The BRIO + Hilbert insertion order of internal points.
+fn spatial_order<const D: usize, const N: usize>(
+    space: &FlatTorus<D>,
+    points: &[[f64; D]],
+    seed: u64,
+) -> Vec<u32>
+where
+    FlatTorus<D>: Torus<D, N>,
+{
+    let keys: Vec<u64> = points.iter().map(|p| space.spatial_key(p)).collect();
+    crate::sort::brio_order(&keys, seed)
+}
+
 /// Reports progress `k` to the build's callback: `Err(Interrupted)` if it asks to stop.
 fn proceed(progress: &mut impl FnMut(usize) -> ControlFlow<()>, k: usize) -> Result<()> {
     match progress(k) {
@@ -189,16 +218,9 @@ where
         if points.is_empty() {
             return Err(Error::EmptyInput);
         }
-        let mut wrapped_pts = Vec::with_capacity(points.len());
-        let mut wrapped = 0;
-        for (i, p) in points.iter().enumerate() {
-            let (w, moved) = internal_point(&space, i, p)?;
-            wrapped += moved as usize;
-            wrapped_pts.push(w);
-        }
+        let (wrapped_pts, wrapped) = internal_points(&space, points)?;
         let order: Vec<u32> = if opts.spatial_sort {
-            let keys: Vec<u64> = wrapped_pts.iter().map(|p| space.spatial_key(p)).collect();
-            crate::sort::brio_order(&keys, opts.seed)
+            spatial_order::<D, N>(&space, &wrapped_pts, opts.seed)
         } else {
             (0..points.len() as u32).collect()
         };
@@ -346,29 +368,20 @@ where
     /// occurrence, as in [`Self::build`]. Returns, per point, the vertex (point index) it
     /// became or coincides with.
     pub fn insert_all(&mut self, points: &[[f64; D]]) -> Result<Vec<Inserted>> {
-        let internal: Vec<([f64; D], bool)> = points
-            .iter()
-            .enumerate()
-            .map(|(row, p)| internal_point(self.space(), row, p))
-            .collect::<Result<_>>()?;
+        let (internal, moved) = internal_points(self.space(), points)?;
         let first = self.input_point.len();
         self.input_point.resize(first + points.len(), NONE);
-        let keys: Vec<u64> = internal
-            .iter()
-            .map(|(w, _)| self.space().spatial_key(w))
-            .collect();
-        let order = crate::sort::brio_order(&keys, BuildOptions::default().seed ^ first as u64);
+        self.wrapped += moved;
+        let seed = BuildOptions::default().seed ^ first as u64;
         let mut out = vec![Inserted::New(0); points.len()];
-        for &k in &order {
-            let (w, moved) = internal[k as usize];
-            self.wrapped += moved as usize;
-            out[k as usize] = self.insert_wrapped(first + k as usize, w);
+        for k in spatial_order::<D, N>(self.space(), &internal, seed) {
+            out[k as usize] = self.insert_wrapped(first + k as usize, internal[k as usize]);
         }
         // a duplicate inserted before its first occurrence lent the point its coordinates
         for (k, r) in out.iter().enumerate() {
             let (Inserted::New(p) | Inserted::Duplicate(p)) = *r;
             if self.point_input[p as usize] as usize == first + k {
-                self.represent(p, internal[k].0);
+                self.represent(p, internal[k]);
             }
         }
         Ok(out)
@@ -436,11 +449,8 @@ where
 
     /// The distinct points (wrapped), indexed by vertex.
     pub fn points(&self) -> Vec<[f64; D]> {
-        let lattice = self.space().lattice();
-        self.engine
-            .points()
-            .iter()
-            .map(|&p| lattice.to_user(p))
+        (0..self.number_of_vertices() as u32)
+            .map(|v| self.point(v))
             .collect()
     }
 
