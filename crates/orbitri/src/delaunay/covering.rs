@@ -158,15 +158,16 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.enter_level(level);
         self.tds.reserve(reps.len());
         for &c in &reps {
-            let cell = &old.cells[c as usize];
-            let mut off = cell.off;
-            self.space.normalize(&mut off, level);
-            let v: [u32; N] =
-                std::array::from_fn(|i| self.vertex_id(old_vpoint[cell.v[i] as usize], off[i]));
-            self.make_cell(v, off);
-        }
-        for (k, &c) in reps.iter().enumerate() {
-            self.tds.cells[k].n = old.cells[c as usize].n.map(|d| orbit[d as usize]);
+            let was = &old.cells[c as usize];
+            let mut cell = Cell::new(was.v, was.off);
+            cell.n = was.n.map(|d| orbit[d as usize]);
+            let reversed = self.space.normalize(&mut cell.off, level);
+            cell.v =
+                std::array::from_fn(|i| self.vertex_id(old_vpoint[was.v[i] as usize], cell.off[i]));
+            if reversed {
+                cell.swap_slots(0, 1);
+            }
+            self.add_cell(cell);
         }
         for k in 0..reps.len() as u32 {
             self.attach(k);

@@ -110,7 +110,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             let j = self.tds.cells[d as usize]
                 .mirror(c)
                 .expect("symmetric neighbours");
-            self.link(nc, i, d, j);
+            self.link(nc, self.slot(nc, x, i), d, j);
             self.tds.cells[c as usize].n[i] = nc;
             scratch.created.push(nc);
         }
@@ -118,13 +118,15 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         for (k, &(ci, i)) in scratch.boundary.iter().enumerate() {
             let nc = scratch.created[k];
             let c0 = scratch.conflict[ci as usize].0;
-            let i = i as usize;
+            // slots of the new cell (the one of `x` is linked already)
             for j in 0..N {
-                if j == i || self.tds.cells[nc as usize].n[j] != NONE {
+                if self.tds.cells[nc as usize].n[j] != NONE {
                     continue;
                 }
-                let c0cell = &self.tds.cells[c0 as usize];
-                let (mut u, mut w) = (c0cell.v[i], c0cell.v[j]);
+                let (mut u, mut w) = (
+                    self.tds.cells[c0 as usize].v[i as usize],
+                    self.tds.cells[nc as usize].v[j],
+                );
                 let mut cur = c0;
                 loop {
                     let cc = &self.tds.cells[cur as usize];
@@ -133,7 +135,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                     if self.tds.stamp(nb) != inside {
                         // (cur, kw) is a boundary facet and nb the new cell built on it
                         let ku = cc.index_of(u).expect("ridge rotation");
-                        self.link(nc, j, nb, ku);
+                        self.link(nc, j, nb, self.slot(nb, u, ku));
                         break;
                     }
                     let m = self.tds.cells[nb as usize]

@@ -281,11 +281,10 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         for v in p * copies..(p + 1) * copies {
             debug_assert_eq!(self.vpoint[v as usize], p);
             for (c, k, _) in self.star(v) {
-                let cell = &mut self.tds.cells[c as usize];
+                let mut cell = self.tds.cells[c as usize];
                 cell.off[k] = self.space.compose(cell.off[k], t);
-                let mut off = cell.off;
-                self.space.normalize(&mut off, self.level);
-                self.tds.cells[c as usize].off = off;
+                self.canonicalize(&mut cell);
+                self.tds.cells[c as usize] = cell;
             }
         }
         self.points[p as usize] = coords;
@@ -307,10 +306,39 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.space.orient(&self.lifted_cell(c))
     }
 
-    /// Creates a cell, normalizing its offsets, and keeps the criterion bookkeeping.
-    fn make_cell(&mut self, v: [u32; N], mut off: [S::Elem; N]) -> u32 {
-        self.space.normalize(&mut off, self.level);
-        let id = self.tds.create(Cell::new(v, off));
+    /// Puts a cell's elements in the canonical form of the current level. When that moves
+    /// the cell by an orientation-reversing element, slots 0 and 1 are exchanged, so that
+    /// the cell stays positively oriented in its frame; callers find slots by vertex
+    /// ([`Self::slot`]), never by position.
+    #[inline]
+    fn canonicalize(&self, cell: &mut Cell<S::Elem, N>) {
+        if self.space.normalize(&mut cell.off, self.level) {
+            cell.swap_slots(0, 1);
+        }
+    }
+
+    /// The slot of vertex `x` in cell `c`, which is `guess` unless canonicalizing the cell
+    /// exchanged slots.
+    #[inline(always)]
+    fn slot(&self, c: u32, x: u32, guess: usize) -> usize {
+        let cell = &self.tds.cells[c as usize];
+        if cell.v[guess] == x {
+            guess
+        } else {
+            cell.index_of(x).expect("the cell holds the vertex")
+        }
+    }
+
+    /// Creates a cell in canonical form and keeps the criterion bookkeeping.
+    fn make_cell(&mut self, v: [u32; N], off: [S::Elem; N]) -> u32 {
+        let mut cell = Cell::new(v, off);
+        self.canonicalize(&mut cell);
+        self.add_cell(cell)
+    }
+
+    /// Stores a canonical cell and keeps the criterion bookkeeping.
+    fn add_cell(&mut self, cell: Cell<S::Elem, N>) -> u32 {
+        let id = self.tds.create(cell);
         if !self.guaranteed {
             self.track(id);
         }

@@ -161,9 +161,13 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             .collect();
         for (k, w) in cells.iter().enumerate() {
             for (m, link) in w.links.iter().enumerate() {
+                let a = self.slot(ids[k], w.vids[m], m);
                 match link.expect("every facet is closed") {
-                    Owner::Old(d, j) => self.link(ids[k], m, d, j),
-                    Owner::New(o, j) => self.link(ids[k], m, ids[o], j),
+                    Owner::Old(d, j) => self.link(ids[k], a, d, j),
+                    Owner::New(o, j) => {
+                        let b = self.slot(ids[o], cells[o].vids[j], j);
+                        self.link(ids[k], a, ids[o], b)
+                    }
                 }
             }
         }

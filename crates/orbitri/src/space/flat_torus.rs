@@ -478,8 +478,14 @@ macro_rules! flat_torus_plugin {
         }
 
         #[inline]
-        fn normalize(&self, off: &mut [Self::Elem; $n], level: usize) {
-            self.normalize_offsets(off, level)
+        fn reverses_orientation(&self, _: Self::Elem) -> bool {
+            false
+        }
+
+        #[inline]
+        fn normalize(&self, off: &mut [Self::Elem; $n], level: usize) -> bool {
+            self.normalize_offsets(off, level);
+            false
         }
 
         fn sheets(&self, level: usize) -> usize {

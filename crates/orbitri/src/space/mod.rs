@@ -96,9 +96,14 @@ pub trait OrbitSpace<const N: usize>: Sync + Send {
     fn single_lift_radius2(&self) -> f64;
     /// The offsets of the copies of one point in the covering of `level` (one per sheet).
     fn covering_copies(&self, level: usize) -> Vec<Self::Elem>;
-    /// Translates a cell's offsets by a group element of the space of `level` into canonical
-    /// form: cells that differ by such a translation get equal offsets.
-    fn normalize(&self, off: &mut [Self::Elem; N], level: usize);
+    /// Whether the element reverses orientation (a reflection or glide reflection; never for
+    /// a torus).
+    fn reverses_orientation(&self, g: Self::Elem) -> bool;
+    /// Moves a cell's elements by a group element `h` of the space of `level` (`g_i ↦ h∘g_i`)
+    /// into canonical form: cells that differ by such an element get equal elements. Returns
+    /// whether `h` reverses orientation: the engine then swaps two vertices, so that the cell
+    /// stays positively oriented in its own frame.
+    fn normalize(&self, off: &mut [Self::Elem; N], level: usize) -> bool;
     /// A dummy point set whose Delaunay triangulation satisfies the switch criterion.
     fn dummy_points(&self) -> Vec<Self::Point>;
     /// Number of sheets of the covering of `level` (`covering_copies(level).len()`).

@@ -32,6 +32,15 @@ impl<O: Copy, const N: usize> Cell<O, N> {
         self.v.iter().position(|&v| v == x)
     }
 
+    /// Exchanges slots `a` and `b`: vertices, neighbours and elements together (the same
+    /// cell, with the opposite orientation of its vertex order).
+    #[inline]
+    pub fn swap_slots(&mut self, a: usize, b: usize) {
+        self.v.swap(a, b);
+        self.n.swap(a, b);
+        self.off.swap(a, b);
+    }
+
     /// Index of neighbour `c` in this cell.
     #[inline]
     pub fn mirror(&self, c: u32) -> Option<usize> {
