@@ -11,8 +11,8 @@ use std::time::Instant;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
 use orbitri::io::SvgOptions;
-use orbitri::periodic::Torus;
 use orbitri::sort::SplitMix;
+use orbitri::triangulation::Torus;
 use orbitri::{
     BuildOptions, FlatTorus, FlatTorus2, FlatTorus3, PeriodicDelaunay, PeriodicDelaunay2,
 };

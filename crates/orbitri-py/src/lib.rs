@@ -22,7 +22,7 @@ use std::time::Duration;
 
 use numpy::ndarray::{Array1, Array2, Array3, ArrayView2};
 use numpy::{AllowTypeChange, IntoPyArray, PyArray1, PyArray2, PyArrayLike2};
-use orbitri::periodic::Torus;
+use orbitri::triangulation::Torus;
 use orbitri::{
     BuildOptions, CellMeasures, FlatTorus, PeriodicDelaunay, PeriodicDelaunay2, PeriodicDelaunay3,
     VoronoiCell,

@@ -28,18 +28,21 @@
 pub mod delaunay;
 pub mod error;
 pub mod io;
-pub mod periodic;
 pub mod predicates;
 pub mod sort;
 pub mod space;
 pub mod tds;
+pub mod triangulation;
 pub mod voronoi;
 
 pub use delaunay::{Engine, Inserted, Invalid};
 pub use error::{Error, Result};
-pub use periodic::{
-    BuildOptions, CellView, Copies, DelaunayEdge, PeriodicDelaunay, PeriodicDelaunay2,
-    PeriodicDelaunay3, Simplex,
+pub use space::{
+    Coset, FlatManifold, FlatSpace, FlatTorus, FlatTorus2, FlatTorus3, Ladder, Lattice, Motion,
+    OrbitSpace,
 };
-pub use space::{FlatTorus, FlatTorus2, FlatTorus3, Ladder, Lattice, OrbitSpace};
+pub use triangulation::{
+    BuildOptions, CellView, Copies, DelaunayEdge, KleinTriangulation, ManifoldTriangulation3,
+    PeriodicDelaunay, PeriodicDelaunay2, PeriodicDelaunay3, Simplex, Triangulation,
+};
 pub use voronoi::{CellMeasures, Neighbor, VoronoiCell, VoronoiFace};

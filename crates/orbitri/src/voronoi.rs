@@ -11,19 +11,20 @@
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
-use crate::periodic::{PeriodicDelaunay, Torus};
-use crate::space::{FlatTorus, OrbitSpace};
+use crate::space::FlatSpace;
+use crate::triangulation::Triangulation;
 
 /// A face of a Voronoi cell: the part of the bisector with one periodic image of a neighbour.
 #[derive(Clone, Debug, PartialEq)]
-pub struct VoronoiFace<const D: usize> {
+pub struct VoronoiFace<const D: usize, E = [i8; D]> {
     /// Indices into the cell's vertices: in 3D a cycle, counter-clockwise seen from outside
     /// the cell; in 2D the two ends of the edge.
     pub vertices: Vec<u32>,
     /// Input id of the neighbour (its first occurrence).
     pub neighbor: u32,
-    /// The neighbour's image across this face is `points[neighbor] + shift·M`.
-    pub shift: [i8; D],
+    /// The neighbour's image across this face is `shift·points[neighbor]` (in a torus
+    /// `points[neighbor] + shift·M`).
+    pub shift: E,
     /// Area of the face (length in 2D).
     pub area: f64,
 }
@@ -31,13 +32,13 @@ pub struct VoronoiFace<const D: usize> {
 /// The Voronoi cell of one point, in Cartesian coordinates around the point's wrapped
 /// position (vertices may lie outside the domain).
 #[derive(Clone, Debug, PartialEq)]
-pub struct VoronoiCell<const D: usize> {
+pub struct VoronoiCell<const D: usize, E = [i8; D]> {
     /// Input id of the point (its first occurrence).
     pub point: u32,
     /// The point's wrapped position.
     pub position: [f64; D],
     pub vertices: Vec<[f64; D]>,
-    pub faces: Vec<VoronoiFace<D>>,
+    pub faces: Vec<VoronoiFace<D, E>>,
     /// Volume (area in 2D).
     pub volume: f64,
     pub centroid: [f64; D],
@@ -57,8 +58,8 @@ pub struct CellMeasures<const D: usize> {
     pub centroid: [f64; D],
 }
 
-impl<const D: usize> From<&VoronoiCell<D>> for CellMeasures<D> {
-    fn from(c: &VoronoiCell<D>) -> Self {
+impl<const D: usize, E> From<&VoronoiCell<D, E>> for CellMeasures<D> {
+    fn from(c: &VoronoiCell<D, E>) -> Self {
         CellMeasures {
             point: c.point,
             volume: c.volume,
@@ -69,13 +70,13 @@ impl<const D: usize> From<&VoronoiCell<D>> for CellMeasures<D> {
     }
 }
 
-/// Two Voronoi neighbours: `j`'s image `points[j] + shift·M` shares a face of this area with
-/// `i`. Each unordered pair of images is listed once.
+/// Two Voronoi neighbours: `j`'s image `shift·points[j]` (in a torus `points[j] + shift·M`)
+/// shares a face of this area with `i`. Each unordered pair of images is listed once.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Neighbor<const D: usize> {
+pub struct Neighbor<const D: usize, E = [i8; D]> {
     pub i: u32,
     pub j: u32,
-    pub shift: [i8; D],
+    pub shift: E,
     pub area: f64,
 }
 
@@ -127,21 +128,18 @@ struct Duals<const D: usize> {
     incident: Vec<(u32, u8)>,
 }
 
-impl<const D: usize, const N: usize> PeriodicDelaunay<D, N>
-where
-    FlatTorus<D>: Torus<D, N>,
-{
+impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> {
     /// The Voronoi cell of input point `i` (a duplicate gets its first occurrence's cell).
     /// It computes the circumcenters and cospherical classes of the whole triangulation
     /// first: for many cells, call [`Self::voronoi_cells`] once.
-    pub fn voronoi_cell(&self, i: usize) -> VoronoiCell<D> {
+    pub fn voronoi_cell(&self, i: usize) -> VoronoiCell<D, S::Elem> {
         let duals = self.duals(&|| false).expect("never interrupted");
         self.cell_of_point(&duals, self.vertex_of_input(i))
     }
 
     /// The Voronoi cells of the distinct points, in the order of their first occurrence
     /// (computed in parallel).
-    pub fn voronoi_cells(&self) -> Vec<VoronoiCell<D>> {
+    pub fn voronoi_cells(&self) -> Vec<VoronoiCell<D, S::Elem>> {
         self.per_cell(|c| c)
     }
 
@@ -168,7 +166,7 @@ where
     pub fn voronoi_cells_until(
         &self,
         interrupt: &(dyn Fn() -> bool + Sync),
-    ) -> Result<Vec<VoronoiCell<D>>> {
+    ) -> Result<Vec<VoronoiCell<D, S::Elem>>> {
         self.per_cell_until(|c| c, interrupt)
     }
 
@@ -185,7 +183,7 @@ where
     /// `f` of every cell, computed in parallel in point order (the spatially sorted
     /// insertion order: neighbouring points share triangulation cells in cache), returned in
     /// the order of first occurrence.
-    fn per_cell<T: Send>(&self, f: impl Fn(VoronoiCell<D>) -> T + Sync) -> Vec<T> {
+    fn per_cell<T: Send>(&self, f: impl Fn(VoronoiCell<D, S::Elem>) -> T + Sync) -> Vec<T> {
         self.per_cell_until(f, &|| false)
             .expect("never interrupted")
     }
@@ -193,7 +191,7 @@ where
     /// `per_cell`, polling `interrupt` every 1024 cells.
     fn per_cell_until<T: Send>(
         &self,
-        f: impl Fn(VoronoiCell<D>) -> T + Sync,
+        f: impl Fn(VoronoiCell<D, S::Elem>) -> T + Sync,
         interrupt: &(dyn Fn() -> bool + Sync),
     ) -> Result<Vec<T>> {
         if interrupt() {
@@ -218,15 +216,16 @@ where
     }
 
     /// The Voronoi neighbour pairs with their shared face areas, each unordered pair of
-    /// images once (`i < j`, or `i == j` with the shift's first non-zero entry positive).
-    pub fn voronoi_neighbors(&self) -> Vec<Neighbor<D>> {
-        neighbor_pairs(&self.voronoi_cells())
+    /// images once (`i < j`, or `i == j` with the shift greater than its inverse: for a
+    /// torus, its first non-zero entry positive).
+    pub fn voronoi_neighbors(&self) -> Vec<Neighbor<D, S::Elem>> {
+        pairs_by(&self.voronoi_cells(), |g| self.space().inverse(g))
     }
 
     /// The shared duals, polling `interrupt` every 1024 cells.
     fn duals(&self, interrupt: &(dyn Fn() -> bool + Sync)) -> Result<Duals<D>> {
         let e = self.engine();
-        let torus = self.space();
+        let space = self.space();
         let ids: Vec<u32> = e.cell_ids().collect();
         let slots = ids.iter().max().map_or(0, |&m| m as usize + 1);
         let computed: Vec<[f64; D]> = ids
@@ -236,7 +235,7 @@ where
                 if k % 1024 == 0 && interrupt() {
                     return Err(Error::Interrupted);
                 }
-                Ok(torus.circumcenter(&e.lifted_cell(c)))
+                Ok(space.circumcenter(&e.lifted_cell(c)))
             })
             .collect::<Result<_>>()?;
         let mut center = vec![[0.0; D]; slots];
@@ -264,9 +263,9 @@ where
                     let shift = e.translation(c, x, d);
                     let opposite = (
                         e.points()[e.point_of(dc.v[y]) as usize],
-                        torus.compose(shift, dc.off[y]),
+                        space.compose(shift, dc.off[y]),
                     );
-                    torus.cospherical(&lifted, opposite).then_some((c, x, d, y))
+                    space.cospherical(&lifted, opposite).then_some((c, x, d, y))
                 })
             })
             .collect();
@@ -303,13 +302,12 @@ where
     }
 
     /// The cell of point index `p`, from the cells around one of its vertices.
-    fn cell_of_point(&self, duals: &Duals<D>, p: u32) -> VoronoiCell<D> {
+    fn cell_of_point(&self, duals: &Duals<D>, p: u32) -> VoronoiCell<D, S::Elem> {
         let e = self.engine();
-        let torus = self.space();
+        let space = self.space();
         let v = e.vertex_of_point(p);
         let star =
             &duals.incident[duals.start[v as usize] as usize..duals.start[v as usize + 1] as usize];
-        let lattice = torus.lattice();
         let position = e.points()[p as usize];
         // one Voronoi vertex per group of star cells joined, through facets at the point, by
         // a shared circumsphere (so in one lift around the point: a sphere met again around
@@ -336,22 +334,24 @@ where
                 let r = root(&mut parent, s);
                 if vertex_of_root[r] == u32::MAX {
                     let (c, k) = star[r];
-                    // the center is relative to the cell's vertex 0
-                    let to_point = torus.lifted_difference(e.lifted(c, k as usize), e.lifted(c, 0));
+                    // the center is relative to the cell's vertex 0, in the cell's frame;
+                    // the point's own frame is that of its element in the cell
+                    let at = e.lifted(c, k as usize);
+                    let to_point = space.lifted_difference(at, e.lifted(c, 0));
                     let z = duals.center[c as usize];
-                    vertices.push(std::array::from_fn(|x| z[x] - to_point[x]));
+                    vertices.push(space.untwist(at.1, std::array::from_fn(|x| z[x] - to_point[x])));
                     vertex_of_root[r] = vertices.len() as u32 - 1;
                 }
                 vertex_of_root[r]
             })
             .collect();
         // faces: the ring of star cells around each Delaunay edge at the point
-        let mut edges: Vec<(u32, [i8; D])> = Vec::new();
+        let mut edges: Vec<(u32, S::Elem)> = Vec::new();
         let mut member: Vec<(u32, u32)> = Vec::with_capacity(star.len() * (N - 1));
         for (s, &(c, k)) in star.iter().enumerate() {
             let cell = e.cell(c);
             for j in (0..N).filter(|&j| j != k as usize) {
-                let key = (cell.v[j], torus.relative(cell.off[j], cell.off[k as usize]));
+                let key = (cell.v[j], space.relative(cell.off[j], cell.off[k as usize]));
                 let f = edges.iter().position(|x| *x == key).unwrap_or_else(|| {
                     edges.push(key);
                     edges.len() - 1
@@ -374,7 +374,7 @@ where
                 continue; // the dual of this Delaunay edge has collapsed: no face
             }
             let wp = e.points()[e.point_of(w) as usize];
-            let dir = torus.lifted_difference((wp, r), (position, [0; D]));
+            let dir = space.lifted_difference((wp, r), (position, space.identity()));
             let pts: Vec<&[f64]> = ids.iter().map(|&i| &vertices[i as usize][..]).collect();
             let area = if D == 2 {
                 let d: Vec<f64> = (0..2).map(|x| pts[1][x] - pts[0][x]).collect();
@@ -399,22 +399,22 @@ where
         }
         // into the user's units: exact scalings by powers of two
         for f in faces.iter_mut() {
-            f.area = lattice.measure_to_user(f.area, D as i32 - 1);
+            f.area = space.measure_to_user(f.area, D as i32 - 1);
         }
-        let around = |x: &[f64; D]| lattice.to_user(std::array::from_fn(|c| position[c] + x[c]));
+        let around = |x: &[f64; D]| space.to_user(std::array::from_fn(|c| position[c] + x[c]));
         VoronoiCell {
             point: self.input_of_vertex(p),
-            position: lattice.to_user(position),
+            position: space.to_user(position),
             vertices: vertices.iter().map(around).collect(),
             faces,
-            volume: lattice.measure_to_user(volume, D as i32),
+            volume: space.measure_to_user(volume, D as i32),
             centroid: around(&centroid_rel),
         }
     }
 
     /// The star cells around the Delaunay edge from the point to `(w, r)`, in cyclic order:
     /// consecutive cells share a facet holding both ends of the edge.
-    fn ring_cycle(&self, star: &[(u32, u8)], ring: &[usize], w: u32, r: [i8; D]) -> Vec<usize> {
+    fn ring_cycle(&self, star: &[(u32, u8)], ring: &[usize], w: u32, r: S::Elem) -> Vec<usize> {
         let e = self.engine();
         let mut cycle = vec![ring[0]];
         let mut prev = u32::MAX;
@@ -449,7 +449,10 @@ where
 /// Volume and centroid (relative to the point) of a cell whose vertices are relative to the
 /// point: in 3D the sum of the tetrahedra from the point to each face's fan triangles, in
 /// 2D of the triangles from the point to each edge (signed by the orientation).
-fn measure<const D: usize>(vertices: &[[f64; D]], faces: &[VoronoiFace<D>]) -> (f64, [f64; D]) {
+fn measure<const D: usize, E>(
+    vertices: &[[f64; D]],
+    faces: &[VoronoiFace<D, E>],
+) -> (f64, [f64; D]) {
     let mut vol = 0.0;
     let mut acc = [0.0; D];
     for f in faces {
@@ -479,7 +482,7 @@ fn measure<const D: usize>(vertices: &[[f64; D]], faces: &[VoronoiFace<D>]) -> (
 /// renumbered and each face running counter-clockwise (from `k` to `k + 1`). The order
 /// follows the faces around the cell, so it is exact however close two vertices are; the
 /// turning sense comes from the polygon's signed area.
-fn order_polygon<const D: usize>(vertices: &mut Vec<[f64; D]>, faces: &mut [VoronoiFace<D>]) {
+fn order_polygon<const D: usize, E>(vertices: &mut Vec<[f64; D]>, faces: &mut [VoronoiFace<D, E>]) {
     let n = vertices.len();
     let mut ends: Vec<Vec<usize>> = vec![Vec::new(); n];
     for (f, face) in faces.iter().enumerate() {
@@ -535,16 +538,25 @@ fn order_polygon<const D: usize>(vertices: &mut Vec<[f64; D]>, faces: &mut [Voro
     }
 }
 
-/// The neighbour pairs of a set of cells, each unordered pair of images once.
+/// The neighbour pairs of a torus's cells, each unordered pair of images once: `i < j`, or
+/// `i == j` with the shift's first non-zero entry positive.
 pub fn neighbor_pairs<const D: usize>(cells: &[VoronoiCell<D>]) -> Vec<Neighbor<D>> {
-    let positive = |s: &[i8; D]| s.iter().find(|&&x| x != 0).is_some_and(|&x| x > 0);
+    pairs_by(cells, |s| s.map(|x| -x))
+}
+
+/// The neighbour pairs, each unordered pair of images once: `i < j`, or `i == j` with the
+/// shift greater than its inverse.
+fn pairs_by<const D: usize, E: Copy + Ord>(
+    cells: &[VoronoiCell<D, E>],
+    inverse: impl Fn(E) -> E,
+) -> Vec<Neighbor<D, E>> {
     cells
         .iter()
         .flat_map(|c| {
             c.faces
                 .iter()
-                .filter(move |f| {
-                    c.point < f.neighbor || (c.point == f.neighbor && positive(&f.shift))
+                .filter(|f| {
+                    c.point < f.neighbor || (c.point == f.neighbor && f.shift > inverse(f.shift))
                 })
                 .map(move |f| Neighbor {
                     i: c.point,

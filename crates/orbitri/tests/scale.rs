@@ -6,7 +6,7 @@
 //! centroids.
 
 mod common;
-use orbitri::periodic::Torus;
+use orbitri::triangulation::Torus;
 use orbitri::{
     Copies, Error, FlatTorus, FlatTorus2, FlatTorus3, Lattice, PeriodicDelaunay, PeriodicDelaunay2,
     PeriodicDelaunay3,

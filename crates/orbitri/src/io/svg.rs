@@ -5,8 +5,8 @@ use std::fmt::Write as _;
 use std::io::Write;
 
 use crate::error::{Error, Result};
-use crate::periodic::PeriodicDelaunay2;
 use crate::space::Lattice;
+use crate::triangulation::PeriodicDelaunay2;
 
 /// What to draw.
 #[derive(Clone, Copy, Debug)]

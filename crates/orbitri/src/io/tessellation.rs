@@ -8,8 +8,8 @@ use std::io::Write;
 
 use super::npy::encode_npy_matrix;
 use super::write::json_f64;
-use crate::periodic::{PeriodicDelaunay, Torus};
 use crate::space::FlatTorus;
+use crate::triangulation::{PeriodicDelaunay, Torus};
 use crate::voronoi::{CellMeasures, Neighbor, VoronoiCell};
 use crate::Copies;
 

@@ -2,8 +2,8 @@
 
 use std::io::Write;
 
-use crate::periodic::{PeriodicDelaunay, Torus};
 use crate::space::FlatTorus;
+use crate::triangulation::{PeriodicDelaunay, Torus};
 
 /// The `cells` format: `SHEETS V C`, then per stored cell its `D + 1` input ids and their
 /// offsets (`D` integers each, lattice units), positively oriented (counter-clockwise in

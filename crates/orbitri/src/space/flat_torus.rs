@@ -6,7 +6,7 @@
 use num_bigint::BigInt;
 
 use super::lattice::{Ladder, Level};
-use super::{Lattice, Lifted};
+use super::{FlatSpace, Lattice, Lifted, OrbitSpace};
 use crate::error::Result;
 use crate::predicates::exact::{self, Scaled};
 use crate::predicates::filter::{self, lifted_diff, plain_diff};
@@ -220,27 +220,7 @@ impl<const D: usize> FlatTorus<D> {
         orient: impl Fn(&[L<D>; N]) -> Sign,
     ) -> Sign {
         let at = |k: usize| if k == N { q } else { s[k] };
-        let mut order: Vec<usize> = (0..=N).collect();
-        for i in 1..=N {
-            let mut j = i;
-            while j > 0 && self.compare_lifted(at(order[j - 1]), at(order[j])) == Sign::Positive {
-                order.swap(j - 1, j);
-                j -= 1;
-            }
-        }
-        for &idx in order.iter().rev() {
-            if idx == N {
-                // the query's own coefficient is the orientation of `s`: positive
-                return Sign::Negative;
-            }
-            let mut t = *s;
-            t[idx] = q;
-            let o = orient(&t);
-            if o != Sign::Zero {
-                return o;
-            }
-        }
-        unreachable!("the order holds the query, whose coefficient is never zero")
+        perturbed_by(s, q, orient, |a, b| self.compare_lifted(at(a), at(b)))
     }
 
     #[inline]
@@ -353,6 +333,105 @@ impl<const D: usize> FlatTorus<D> {
         let f = self.lattice.fractional_in(p);
         let scale = (1u64 << bits) as f64;
         f.map(|v| ((v.clamp(0.0, 1.0) * scale) as u64).min((1 << bits) - 1) as u32)
+    }
+}
+
+/// The symbolic perturbation of a cospherical in-sphere test for a given order of the
+/// lifted points (`compare(a, b)` on indices, `N` meaning the query): from the largest down,
+/// the first non-zero coefficient of the perturbed determinant, the orientation of `s` with
+/// that point replaced by `q`. The order must be invariant under the group of the space, so
+/// that every copy of a configuration gets the same answer.
+pub(super) fn perturbed_by<const D: usize, const N: usize>(
+    s: &[L<D>; N],
+    q: L<D>,
+    orient: impl Fn(&[L<D>; N]) -> Sign,
+    compare: impl Fn(usize, usize) -> Sign,
+) -> Sign {
+    let mut order: Vec<usize> = (0..=N).collect();
+    for i in 1..=N {
+        let mut j = i;
+        while j > 0 && compare(order[j - 1], order[j]) == Sign::Positive {
+            order.swap(j - 1, j);
+            j -= 1;
+        }
+    }
+    for &idx in order.iter().rev() {
+        if idx == N {
+            // the query's own coefficient is the orientation of `s`: positive
+            return Sign::Negative;
+        }
+        let mut t = *s;
+        t[idx] = q;
+        let o = orient(&t);
+        if o != Sign::Zero {
+            return o;
+        }
+    }
+    unreachable!("the order holds the query, whose coefficient is never zero")
+}
+
+/// The unperturbed in-sphere sign of a lifted simplex (`Zero` when cospherical), exact: for
+/// spaces that evaluate their predicates on a torus and perturb with an order of their own.
+pub(crate) trait UnperturbedInSphere<const D: usize, const N: usize> {
+    fn in_sphere_unperturbed(&self, s: &[L<D>; N], q: L<D>) -> Sign;
+}
+
+impl<const D: usize, const N: usize> FlatSpace<D, N> for FlatTorus<D>
+where
+    FlatTorus<D>: OrbitSpace<N, Point = [f64; D], Elem = [i8; D]>,
+{
+    fn canonical_point(&self, x: &[f64; D]) -> Option<([f64; D], bool)> {
+        self.lattice.wrap_in(*x)
+    }
+
+    fn to_user(&self, x: [f64; D]) -> [f64; D] {
+        self.lattice.to_user(x)
+    }
+
+    fn measure_to_user(&self, x: f64, power: i32) -> f64 {
+        self.lattice.measure_to_user(x, power)
+    }
+
+    fn lifted_position(&self, p: L<D>) -> [f64; D] {
+        self.position(p)
+    }
+
+    fn lifted_difference(&self, a: L<D>, b: L<D>) -> [f64; D] {
+        FlatTorus::lifted_difference(self, a, b)
+    }
+
+    fn untwist(&self, _: [i8; D], v: [f64; D]) -> [f64; D] {
+        v
+    }
+
+    fn relating(&self, from: [f64; D], to: [f64; D]) -> Option<[i8; D]> {
+        // from + t·M == to for an integer t: found approximately, confirmed exactly
+        let d: [f64; D] = std::array::from_fn(|c| to[c] - from[c]);
+        let t = self.lattice.fractional_in(&d).map(|x| x.round());
+        if t.iter().any(|x| x.abs() > 100.0) {
+            return None;
+        }
+        let t = t.map(|x| x as i8);
+        self.coincide_lifted((from, t), (to, [0; D])).then_some(t)
+    }
+
+    /// The componentwise least offset is translated to zero, then the pairs are sorted.
+    fn canonical_face(&self, pairs: &mut [(u32, [i8; D])]) {
+        for c in 0..D {
+            let m = pairs.iter().map(|p| p.1[c]).min().unwrap_or(0);
+            for p in pairs.iter_mut() {
+                p.1[c] -= m;
+            }
+        }
+        pairs.sort_unstable();
+    }
+
+    fn volume(&self) -> f64 {
+        self.lattice.volume()
+    }
+
+    fn check_volume_representable(&self) -> Result<()> {
+        self.lattice.check_volume_representable()
     }
 }
 

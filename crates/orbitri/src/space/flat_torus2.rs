@@ -4,7 +4,7 @@
 
 use num_bigint::BigInt;
 
-use super::flat_torus::{flat_torus_plugin, L};
+use super::flat_torus::{flat_torus_plugin, UnperturbedInSphere, L};
 use super::{FlatTorus, OrbitSpace};
 use crate::predicates::exact;
 use crate::predicates::filter;
@@ -50,6 +50,13 @@ fn center_polynomials(d: &[[f64; 2]; 2], minus: fn(f64, f64) -> f64) -> ([f64; 2
         ],
         det,
     )
+}
+
+impl UnperturbedInSphere<2, 3> for FlatTorus<2> {
+    #[inline(always)]
+    fn in_sphere_unperturbed(&self, s: &[L2; 3], q: L2) -> Sign {
+        self.in_sphere_raw(s, q)
+    }
 }
 
 impl OrbitSpace<3> for FlatTorus<2> {

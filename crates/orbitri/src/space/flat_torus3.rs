@@ -3,7 +3,7 @@
 
 use num_bigint::BigInt;
 
-use super::flat_torus::{flat_torus_plugin, L};
+use super::flat_torus::{flat_torus_plugin, UnperturbedInSphere, L};
 use super::{FlatTorus, OrbitSpace};
 use crate::predicates::exact;
 use crate::predicates::filter;
@@ -65,6 +65,13 @@ fn center_polynomials(d: &[[f64; 3]; 3], minus: fn(f64, f64) -> f64) -> ([f64; 3
         std::array::from_fn(|k| l[0] * c12[k] + l[1] * c20[k] + l[2] * c01[k]),
         det,
     )
+}
+
+impl UnperturbedInSphere<3, 4> for FlatTorus<3> {
+    #[inline(always)]
+    fn in_sphere_unperturbed(&self, s: &[L3; 4], q: L3) -> Sign {
+        self.in_sphere_raw(s, q)
+    }
 }
 
 impl OrbitSpace<4> for FlatTorus<3> {

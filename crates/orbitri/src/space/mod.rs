@@ -1,12 +1,15 @@
 //! Orbit spaces as plug-ins of the engine: each knows its group elements (offsets), its exact
 //! predicates on lifted points, its covering space and its switch criterion.
 
+mod flat_manifold;
 mod flat_torus;
 mod flat_torus2;
 mod flat_torus3;
+mod klein_bottle;
 mod lattice;
 mod sublattice;
 
+pub use flat_manifold::{Coset, FlatManifold, Motion};
 pub use flat_torus::{FlatTorus, FlatTorus2, FlatTorus3, Offset3};
 pub(crate) use lattice::ldexp;
 pub use lattice::{Ladder, Lattice, Level, MAX_COPIES, MAX_DEFECT};
@@ -124,4 +127,68 @@ pub trait OrbitSpace<const N: usize>: Sync + Send {
     fn edge_bound(&self, level: usize) -> f64;
     /// A key along a space-filling curve, for spatial sorting.
     fn spatial_key(&self, p: &Self::Point) -> u64;
+}
+
+/// A flat orbit space as the facade, the Voronoi layer and the writers see it: points
+/// `[f64; D]` in the user's units outside, in the space's internal frame (a power-of-two
+/// scaling, see [`Lattice`]) inside, each stored at a canonical representative in the
+/// fundamental domain.
+pub trait FlatSpace<const D: usize, const N: usize>:
+    OrbitSpace<N, Point = [f64; D]> + Clone
+{
+    /// The representative of a user point in the fundamental domain, in the internal frame,
+    /// and whether it moved; `None` when it lies too far away to be wrapped exactly.
+    fn canonical_point(&self, x: &[f64; D]) -> Option<([f64; D], bool)>;
+    /// An internal point in user units (exact).
+    fn to_user(&self, x: [f64; D]) -> [f64; D];
+    /// An internal length (`power` 1), area (2) or volume (3) in user units.
+    fn measure_to_user(&self, x: f64, power: i32) -> f64;
+    /// The Cartesian position of a lifted point, internal frame, rounded.
+    fn lifted_position(&self, p: Lifted<[f64; D], Self::Elem>) -> [f64; D];
+    /// The difference of two lifted points, internal frame, within a few units in the last
+    /// place of their magnitudes (not through rounded positions).
+    fn lifted_difference(
+        &self,
+        a: Lifted<[f64; D], Self::Elem>,
+        b: Lifted<[f64; D], Self::Elem>,
+    ) -> [f64; D];
+    /// A vector in the frame of `g` seen from the frame of the identity: `A⁻¹·v` for
+    /// `g: x ↦ A·x + t` (`v` itself for a translation).
+    fn untwist(&self, g: Self::Elem, v: [f64; D]) -> [f64; D];
+    /// The element `g` with `g·from = to` exactly, when `from` and `to` (internal frame) are
+    /// two representatives of one point of the space.
+    fn relating(&self, from: [f64; D], to: [f64; D]) -> Option<Self::Elem>;
+    /// A face given by (vertex, element) pairs in canonical form modulo the group: two
+    /// faces that differ by a group element get equal pairs, sorted.
+    fn canonical_face(&self, pairs: &mut [(u32, Self::Elem)]);
+    /// The volume (area in 2D) of the space, in user units.
+    fn volume(&self) -> f64;
+    /// Ok when the space's volume is a normal double in user units (see
+    /// [`Lattice::check_volume_representable`]).
+    fn check_volume_representable(&self) -> crate::error::Result<()>;
+}
+
+/// [`FlatSpace::canonical_face`] for any group: among the translations by `g_i⁻¹` (which
+/// bring vertex `i` to the identity), the one giving the least sorted pairs. It is unique for
+/// a torsion-free group: no element other than the identity permutes a finite set of
+/// elements.
+pub(crate) fn least_translate<S: OrbitSpace<N>, const N: usize>(
+    space: &S,
+    pairs: &mut [(u32, S::Elem)],
+) {
+    let mut best: Option<Vec<(u32, S::Elem)>> = None;
+    for i in 0..pairs.len() {
+        let h = space.inverse(pairs[i].1);
+        let mut moved: Vec<(u32, S::Elem)> = pairs
+            .iter()
+            .map(|&(v, g)| (v, space.compose(h, g)))
+            .collect();
+        moved.sort_unstable();
+        if best.as_ref().is_none_or(|b| moved < *b) {
+            best = Some(moved);
+        }
+    }
+    if let Some(b) = best {
+        pairs.copy_from_slice(&b);
+    }
 }

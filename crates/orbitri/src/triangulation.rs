@@ -1,14 +1,15 @@
-//! `PeriodicDelaunay<D, N>`: the Delaunay triangulation of a point set in a flat torus of
-//! dimension `D` (cells of `N = D + 1` vertices), with input bookkeeping (wrapping,
-//! duplicates), bulk construction and the access API; `PeriodicDelaunay2` and
-//! `PeriodicDelaunay3` name the two dimensions.
+//! `Triangulation<D, N, S>`: the Delaunay triangulation of a point set in a flat orbit space
+//! `S` of dimension `D` (cells of `N = D + 1` vertices), with input bookkeeping (wrapping into
+//! the domain, duplicates), bulk construction and the access API, written once for every
+//! space. `PeriodicDelaunay2` and `PeriodicDelaunay3` name the flat tori, `KleinBottle`
+//! and `FlatManifold3` the other closed flat manifolds.
 
 use std::collections::HashSet;
 use std::ops::ControlFlow;
 
 use crate::delaunay::{Engine, Inserted, Invalid};
 use crate::error::{Error, Result};
-use crate::space::{FlatTorus, OrbitSpace};
+use crate::space::{FlatManifold, FlatSpace, FlatTorus, OrbitSpace};
 use crate::tds::NONE;
 
 /// Offset of a vertex in lattice-vector units.
@@ -35,28 +36,31 @@ pub enum Copies {
     Stored,
 }
 
-/// A cell: input ids of its vertices and their offsets, positively oriented
+/// A cell: input ids of its vertices and their group elements (a torus's offsets), the
+/// vertex `k` lying at `offsets[k]·points[vertices[k]]`; positively oriented
 /// (counter-clockwise in 2D).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct CellView<const D: usize = 3, const N: usize = 4> {
+pub struct CellView<const D: usize = 3, const N: usize = 4, E = Offset<D>> {
     pub vertices: [u32; N],
-    pub offsets: [Offset<D>; N],
+    pub offsets: [E; N],
 }
 
-/// A simplex of lower dimension (edge: 2 vertices, facet: `D`), canonical: sorted by
-/// (vertex, offset) with the componentwise minimum offset translated to zero.
+/// A simplex of lower dimension (edge: 2 vertices, facet: `D`), canonical modulo the group:
+/// for a torus, sorted by (vertex, offset) with the componentwise minimum offset translated
+/// to zero.
 #[derive(Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct Simplex<const D: usize = 3> {
+pub struct Simplex<const D: usize = 3, E = Offset<D>> {
     pub vertices: Vec<u32>,
-    pub offsets: Vec<Offset<D>>,
+    pub offsets: Vec<E>,
 }
 
-/// A Delaunay edge of the torus: `j`'s image `points[j] + shift·M` is joined to point `i`.
+/// A Delaunay edge: `j`'s image `shift·points[j]` (`points[j] + shift·M` in a torus) is
+/// joined to point `i`.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct DelaunayEdge<const D: usize> {
+pub struct DelaunayEdge<const D: usize, E = Offset<D>> {
     pub i: u32,
     pub j: u32,
-    pub shift: Offset<D>,
+    pub shift: E,
     pub length: f64,
 }
 
@@ -81,13 +85,10 @@ impl Default for BuildOptions {
     }
 }
 
-/// The periodic Delaunay triangulation of a flat torus of dimension `D`.
+/// The Delaunay triangulation of a point set in the flat orbit space `S` of dimension `D`.
 #[derive(Debug)]
-pub struct PeriodicDelaunay<const D: usize, const N: usize>
-where
-    FlatTorus<D>: Torus<D, N>,
-{
-    engine: Engine<FlatTorus<D>, N>,
+pub struct Triangulation<const D: usize, const N: usize, S: FlatSpace<D, N> = FlatTorus<D>> {
+    engine: Engine<S, N>,
     /// Input index → point (vertex) index.
     input_point: Vec<u32>,
     /// Point index → input index of its first occurrence.
@@ -97,15 +98,21 @@ where
     used_dummies: bool,
 }
 
+/// The periodic Delaunay triangulation of a flat torus of dimension `D`.
+pub type PeriodicDelaunay<const D: usize, const N: usize> = Triangulation<D, N, FlatTorus<D>>;
 /// The periodic Delaunay triangulation of a 2D flat torus.
 pub type PeriodicDelaunay2 = PeriodicDelaunay<2, 3>;
 /// The periodic Delaunay triangulation of a 3D flat torus.
 pub type PeriodicDelaunay3 = PeriodicDelaunay<3, 4>;
+/// The Delaunay triangulation of a Klein bottle (a 2D flat manifold).
+pub type KleinTriangulation = Triangulation<2, 3, FlatManifold<2>>;
+/// The Delaunay triangulation of a closed flat 3-manifold.
+pub type ManifoldTriangulation3 = Triangulation<3, 4, FlatManifold<3>>;
 
 /// Input point `i` in the internal frame of the lattice, wrapped into the domain, and whether
 /// wrapping moved it; an error names a non-finite coordinate or a point out of reach.
-fn internal_point<const D: usize>(
-    space: &FlatTorus<D>,
+fn internal_point<const D: usize, const N: usize, S: FlatSpace<D, N>>(
+    space: &S,
     i: usize,
     p: &[f64; D],
 ) -> Result<([f64; D], bool)> {
@@ -118,19 +125,16 @@ fn internal_point<const D: usize>(
             });
         }
     }
-    space
-        .lattice()
-        .wrap_in(*p)
-        .ok_or_else(|| Error::OutOfReach {
-            index: i,
-            coordinates: format!("{p:?}"),
-        })
+    space.canonical_point(p).ok_or_else(|| Error::OutOfReach {
+        index: i,
+        coordinates: format!("{p:?}"),
+    })
 }
 
 /// Every point of `points` in the internal frame, wrapped (an error names the first bad
 /// one by its index in `points`), and how many wrapping moved.
-fn internal_points<const D: usize>(
-    space: &FlatTorus<D>,
+fn internal_points<const D: usize, const N: usize, S: FlatSpace<D, N>>(
+    space: &S,
     points: &[[f64; D]],
 ) -> Result<(Vec<[f64; D]>, usize)> {
     let mut out = Vec::with_capacity(points.len());
@@ -144,14 +148,11 @@ fn internal_points<const D: usize>(
 }
 
 /// The BRIO + Hilbert insertion order of internal points.
-fn spatial_order<const D: usize, const N: usize>(
-    space: &FlatTorus<D>,
+fn spatial_order<const D: usize, const N: usize, S: FlatSpace<D, N>>(
+    space: &S,
     points: &[[f64; D]],
     seed: u64,
-) -> Vec<u32>
-where
-    FlatTorus<D>: Torus<D, N>,
-{
+) -> Vec<u32> {
     let keys: Vec<u64> = points.iter().map(|p| space.spatial_key(p)).collect();
     crate::sort::brio_order(&keys, seed)
 }
@@ -164,13 +165,10 @@ fn proceed(progress: &mut impl FnMut(usize) -> ControlFlow<()>, k: usize) -> Res
     }
 }
 
-impl<const D: usize, const N: usize> PeriodicDelaunay<D, N>
-where
-    FlatTorus<D>: Torus<D, N>,
-{
-    /// An empty triangulation of the torus.
-    pub fn new(space: FlatTorus<D>) -> Self {
-        PeriodicDelaunay {
+impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> {
+    /// An empty triangulation of the space.
+    pub fn new(space: S) -> Self {
+        Triangulation {
             engine: Engine::new(space),
             input_point: Vec::new(),
             point_input: Vec::new(),
@@ -181,7 +179,7 @@ where
     }
 
     /// Builds the triangulation of `points` (wrapped into the domain first).
-    pub fn build(space: FlatTorus<D>, points: &[[f64; D]]) -> Result<Self> {
+    pub fn build(space: S, points: &[[f64; D]]) -> Result<Self> {
         Self::build_with(space, points, BuildOptions::default(), |_| {
             ControlFlow::Continue(())
         })
@@ -210,7 +208,7 @@ where
     /// assert!(matches!(r, Err(Error::Interrupted)));
     /// ```
     pub fn build_with(
-        space: FlatTorus<D>,
+        space: S,
         points: &[[f64; D]],
         opts: BuildOptions,
         mut progress: impl FnMut(usize) -> ControlFlow<()>,
@@ -220,7 +218,7 @@ where
         }
         let (wrapped_pts, wrapped) = internal_points(&space, points)?;
         let order: Vec<u32> = if opts.spatial_sort {
-            spatial_order::<D, N>(&space, &wrapped_pts, opts.seed)
+            spatial_order(&space, &wrapped_pts, opts.seed)
         } else {
             (0..points.len() as u32).collect()
         };
@@ -265,23 +263,16 @@ where
     }
 
     /// Gives point `p` the wrapped coordinates `want` of its first occurrence, when they
-    /// differ from the current ones by an exact lattice translation.
+    /// differ from the current ones by an exact group element.
     fn represent(&mut self, p: u32, want: [f64; D]) {
         let have = self.engine.points()[p as usize];
         if want == have {
             return;
         }
-        // want + t·M == have for an integer t: found approximately, confirmed exactly
-        let d: [f64; D] = std::array::from_fn(|c| have[c] - want[c]);
-        let t = self
-            .space()
-            .lattice()
-            .fractional_in(&d)
-            .map(|x| x.round() as i8);
-        let exact = self.space().coincide((want, t), (have, [0; D]));
-        debug_assert!(exact, "a duplicate is an exact lattice translate");
-        if exact {
-            self.engine.move_representative(p, want, t);
+        let g = self.space().relating(want, have);
+        debug_assert!(g.is_some(), "a duplicate is an exact image");
+        if let Some(g) = g {
+            self.engine.move_representative(p, want, g);
         }
     }
 
@@ -374,7 +365,7 @@ where
         self.wrapped += moved;
         let seed = BuildOptions::default().seed ^ first as u64;
         let mut out = vec![Inserted::New(0); points.len()];
-        for k in spatial_order::<D, N>(self.space(), &internal, seed) {
+        for k in spatial_order(self.space(), &internal, seed) {
             out[k as usize] = self.insert_wrapped(first + k as usize, internal[k as usize]);
         }
         // a duplicate inserted before its first occurrence lent the point its coordinates
@@ -388,12 +379,12 @@ where
     }
 
     /// The orbit space.
-    pub fn space(&self) -> &FlatTorus<D> {
+    pub fn space(&self) -> &S {
         self.engine.space()
     }
 
     /// The engine (for generic algorithms).
-    pub fn engine(&self) -> &Engine<FlatTorus<D>, N> {
+    pub fn engine(&self) -> &Engine<S, N> {
         &self.engine
     }
 
@@ -456,17 +447,15 @@ where
 
     /// The wrapped position of vertex `v` (a point index).
     pub fn point(&self, v: u32) -> [f64; D] {
-        self.space()
-            .lattice()
-            .to_user(self.engine.points()[v as usize])
+        self.space().to_user(self.engine.points()[v as usize])
     }
 
-    /// The position of input point `i`'s image under the lattice translation `offset`:
-    /// `points[i] + offset·M`, in Cartesian coordinates.
-    pub fn position(&self, i: u32, offset: Offset<D>) -> [f64; D] {
+    /// The position of input point `i`'s image under the group element `offset` (in a
+    /// torus, `points[i] + offset·M`), in Cartesian coordinates.
+    pub fn position(&self, i: u32, offset: S::Elem) -> [f64; D] {
         let p = self.engine.points()[self.vertex_of_input(i as usize) as usize];
         let space = self.space();
-        space.lattice().to_user(space.position((p, offset)))
+        space.to_user(space.lifted_position((p, offset)))
     }
 
     /// The vertex of input point `i`.
@@ -487,9 +476,9 @@ where
             .collect()
     }
 
-    fn view(&self, c: u32) -> CellView<D, N> {
+    fn view(&self, c: u32) -> CellView<D, N, S::Elem> {
         let cell = self.engine.cell(c);
-        CellView::<D, N> {
+        CellView {
             vertices: cell
                 .v
                 .map(|x| self.point_input[self.engine.point_of(x) as usize]),
@@ -498,13 +487,13 @@ where
     }
 
     /// Every stored cell, lazily (for writers of large triangulations).
-    pub fn stored_cells(&self) -> impl Iterator<Item = CellView<D, N>> + '_ {
+    pub fn stored_cells(&self) -> impl Iterator<Item = CellView<D, N, S::Elem>> + '_ {
         self.engine.cell_ids().map(|c| self.view(c))
     }
 
     /// Every stored cell (as `stored_cells`) with its neighbours: `neighbors[k][i]` is the
     /// position in this list of the cell opposite vertex `i` of cell `k`.
-    pub fn cells_with_neighbors(&self) -> (Vec<CellView<D, N>>, Vec<[u32; N]>) {
+    pub fn cells_with_neighbors(&self) -> (Vec<CellView<D, N, S::Elem>>, Vec<[u32; N]>) {
         let ids: Vec<u32> = self.engine.cell_ids().collect();
         let slots = ids.iter().max().map_or(0, |&m| m as usize + 1);
         let mut position = vec![u32::MAX; slots];
@@ -520,40 +509,43 @@ where
     }
 
     /// The cells with input ids and offsets: every stored cell, or one per orbit.
-    pub fn cells(&self, copies: Copies) -> Vec<CellView<D, N>> {
+    pub fn cells(&self, copies: Copies) -> Vec<CellView<D, N, S::Elem>> {
         if copies == Copies::Stored || self.is_one_sheeted() {
             return self.stored_cells().collect();
         }
         let mut seen = HashSet::new();
         self.stored_cells()
-            .filter(|c| seen.insert(canonical(&c.vertices, &c.offsets)))
+            .filter(|c| seen.insert(canonical(self.space(), &c.vertices, &c.offsets)))
             .collect()
     }
 
     /// A face of a stored cell (the slots in `idx`): its vertices as input ids (`Unique`)
     /// or stored vertex ids (`Stored`), in canonical form.
-    fn face(&self, c: u32, idx: &[usize], copies: Copies) -> Simplex<D> {
+    fn face(&self, c: u32, idx: &[usize], copies: Copies) -> Simplex<D, S::Elem> {
         let cell = self.engine.cell(c);
         let id = |x: u32| match copies {
             Copies::Unique => self.point_input[self.engine.point_of(x) as usize],
             Copies::Stored => x,
         };
         let v: Vec<u32> = idx.iter().map(|&i| id(cell.v[i])).collect();
-        let o: Vec<Offset<D>> = idx.iter().map(|&i| cell.off[i]).collect();
-        let (vertices, offsets) = canonical(&v, &o);
+        let o: Vec<S::Elem> = idx.iter().map(|&i| cell.off[i]).collect();
+        let (vertices, offsets) = canonical(self.space(), &v, &o);
         Simplex { vertices, offsets }
     }
 
     /// In a covering space, one copy per orbit of faces (canonical forms deduplicated).
-    fn unique_in_covering(&self, faces: impl Iterator<Item = Simplex<D>>) -> Vec<Simplex<D>> {
-        let mut out: Vec<Simplex<D>> = faces.collect::<HashSet<_>>().into_iter().collect();
+    fn unique_in_covering(
+        &self,
+        faces: impl Iterator<Item = Simplex<D, S::Elem>>,
+    ) -> Vec<Simplex<D, S::Elem>> {
+        let mut out: Vec<Simplex<D, S::Elem>> = faces.collect::<HashSet<_>>().into_iter().collect();
         out.sort_unstable();
         out
     }
 
     /// The edges (input ids, offsets), each once; `Stored` lists covering copies by vertex
     /// id. Found from each vertex's neighbours, towards the larger vertex id.
-    pub fn edges(&self, copies: Copies) -> Vec<Simplex<D>> {
+    pub fn edges(&self, copies: Copies) -> Vec<Simplex<D, S::Elem>> {
         let id = move |x: u32| match copies {
             Copies::Unique => self.point_input[self.engine.point_of(x) as usize],
             Copies::Stored => x,
@@ -564,7 +556,11 @@ where
                 .into_iter()
                 .filter(move |w| w.0 > v)
                 .map(move |(w, rel)| {
-                    let (vertices, offsets) = canonical(&[id(v), id(w)], &[[0; D], rel]);
+                    let (vertices, offsets) = canonical(
+                        self.space(),
+                        &[id(v), id(w)],
+                        &[self.space().identity(), rel],
+                    );
                     Simplex { vertices, offsets }
                 })
         });
@@ -575,22 +571,23 @@ where
     }
 
     /// The Delaunay edges of the torus, each once, with input ids, shift and length.
-    pub fn delaunay_edges(&self) -> Vec<DelaunayEdge<D>> {
+    pub fn delaunay_edges(&self) -> Vec<DelaunayEdge<D, S::Elem>> {
+        let space = self.space();
         self.edges(Copies::Unique)
             .into_iter()
             .map(|s| {
                 let at = |k: usize| {
                     let p =
                         self.engine.points()[self.vertex_of_input(s.vertices[k] as usize) as usize];
-                    self.space().position((p, s.offsets[k]))
+                    (p, s.offsets[k])
                 };
-                let (a, b) = (at(0), at(1));
-                let length = (0..D).map(|c| (b[c] - a[c]).powi(2)).sum::<f64>().sqrt();
+                let d = space.lifted_difference(at(1), at(0));
+                let length = d.iter().map(|x| x * x).sum::<f64>().sqrt();
                 DelaunayEdge {
                     i: s.vertices[0],
                     j: s.vertices[1],
-                    shift: std::array::from_fn(|c| s.offsets[1][c] - s.offsets[0][c]),
-                    length: self.space().lattice().measure_to_user(length, 1),
+                    shift: space.relative(s.offsets[1], s.offsets[0]),
+                    length: space.measure_to_user(length, 1),
                 }
             })
             .collect()
@@ -598,7 +595,7 @@ where
 
     /// The facets, each once (from the cell with the smaller id); `Stored` lists covering
     /// copies by vertex id.
-    pub fn facets(&self, copies: Copies) -> Vec<Simplex<D>> {
+    pub fn facets(&self, copies: Copies) -> Vec<Simplex<D, S::Elem>> {
         let all = self.engine.cell_ids().flat_map(|c| {
             let n = self.engine.cell(c).n;
             (0..N).filter(move |&i| c < n[i]).map(move |i| (c, i))
@@ -615,9 +612,9 @@ where
 
     /// The neighbours of input point `i`: (input id, offset of the neighbour relative to
     /// the point), one entry per Delaunay edge at the point, from the point's star.
-    pub fn vertex_neighbors(&self, i: usize) -> Vec<(u32, Offset<D>)> {
+    pub fn vertex_neighbors(&self, i: usize) -> Vec<(u32, S::Elem)> {
         let v = self.engine.vertex_of_point(self.input_point[i]);
-        let mut out: Vec<(u32, Offset<D>)> = self
+        let mut out: Vec<(u32, S::Elem)> = self
             .engine
             .neighbours(v)
             .into_iter()
@@ -628,7 +625,7 @@ where
     }
 
     /// The cell containing `p` (wrapped into the domain) and the offset of `p` in its frame.
-    pub fn locate(&mut self, p: [f64; D]) -> Result<(CellView<D, N>, Offset<D>)> {
+    pub fn locate(&mut self, p: [f64; D]) -> Result<(CellView<D, N, S::Elem>, S::Elem)> {
         if self.number_of_vertices() == 0 {
             return Err(Error::EmptyInput);
         }
@@ -643,16 +640,13 @@ where
     }
 }
 
-/// Canonical form of a simplex given by vertices and offsets: sorted pairs, translated so
-/// that the componentwise minimum offset is zero.
-fn canonical<const D: usize>(v: &[u32], o: &[Offset<D>]) -> (Vec<u32>, Vec<Offset<D>>) {
-    let mut pairs: Vec<(u32, Offset<D>)> = v.iter().copied().zip(o.iter().copied()).collect();
-    for c in 0..D {
-        let m = pairs.iter().map(|p| p.1[c]).min().unwrap();
-        for p in pairs.iter_mut() {
-            p.1[c] -= m;
-        }
-    }
-    pairs.sort_unstable();
+/// Canonical form modulo the group of a simplex given by vertices and elements.
+fn canonical<const D: usize, const N: usize, S: FlatSpace<D, N>>(
+    space: &S,
+    v: &[u32],
+    o: &[S::Elem],
+) -> (Vec<u32>, Vec<S::Elem>) {
+    let mut pairs: Vec<(u32, S::Elem)> = v.iter().copied().zip(o.iter().copied()).collect();
+    space.canonical_face(&mut pairs);
     pairs.into_iter().unzip()
 }

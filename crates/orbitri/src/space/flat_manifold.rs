@@ -1,0 +1,886 @@
+//! Closed flat manifolds `E^D/G`, `G` a Bieberbach group (thesis §4.2, Caroli–Teillaud): the
+//! translations `T` of a lattice `M` and `k` cosets of them, represented by isometries
+//! `r_c: x ↦ A_c·x + s_c·M/q` whose linear parts `A_c` are signed permutation matrices and
+//! whose translations are multiples of `M/q` for a power of two `q`. Every element is
+//! `g = (c, o): x ↦ A_c·x + (s_c/q + o)·M`, `o` an integer vector.
+//!
+//! The predicates are exact because a lifted point `g·p = A_c·p + (s_c + q·o)·M/q` is a
+//! signed permutation of the stored coordinates (exact) plus an integer combination of the
+//! rows of `M/q`: a lifted point of the flat torus of `M/q`, whose filters and exact
+//! fallbacks are reused as they are. The symbolic perturbation orders lifted points by
+//! their stored coordinates (one orbit, one stored point: invariant under `G`), and copies of
+//! one point, which meet in one test only in the coverings, by their lifted position
+//! (invariant under the translations the coverings have).
+//!
+//! The covering ladder is the torus of `T`'s ladder (`k` sheets per torus sheet) followed by
+//! the manifold itself: Caroli–Teillaud's Theorem 10 with the translational subgroup.
+
+use super::flat_torus::{perturbed_by, UnperturbedInSphere, L};
+use super::lattice::{Ladder, Level};
+use super::{least_translate, FlatSpace, FlatTorus, Lattice, OrbitSpace};
+use crate::error::{Error, Result};
+use crate::predicates::Sign;
+
+/// A group element `x ↦ A_c·x + (s_c/q + o)·M`: coset `coset` of the translations, lattice
+/// offset `offset`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct Motion<const D: usize> {
+    pub coset: u8,
+    pub offset: [i8; D],
+}
+
+/// A coset representative `x ↦ A·x + s·M/q` as given to [`FlatManifold::new`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Coset<const D: usize> {
+    /// `A`, a signed permutation matrix: `linear[i][j]` is the coefficient of `x_j` in
+    /// output coordinate `i`.
+    pub linear: [[i8; D]; D],
+    /// `s`: the translation in units of the rows of `M/q`.
+    pub shift: [i32; D],
+}
+
+/// A coset with what the group law needs.
+#[derive(Clone, Debug)]
+struct CosetData<const D: usize> {
+    /// Output coordinate `i` is `sign·x_j`: `(j, sign)`.
+    perm: [(usize, f64); D],
+    linear: [[i32; D]; D],
+    /// The action of `A` on lattice coordinates: `A·(o·M) = (o·R)·M`.
+    r: [[i32; D]; D],
+    shift: [i32; D],
+    reverses: bool,
+}
+
+/// A closed flat manifold: the orbit space of a Bieberbach group.
+#[derive(Clone, Debug)]
+pub struct FlatManifold<const D: usize> {
+    name: &'static str,
+    translations: Lattice<D>,
+    /// The torus of `M/q`: its lattice gives the internal frame, its predicates the exact
+    /// tests on lifted points.
+    fine: FlatTorus<D>,
+    q: i32,
+    cosets: Vec<CosetData<D>>,
+    /// `r_a∘r_b = (c, κ)`: the coset of the product and its lattice offset, at `a·k + b`.
+    product: Vec<(u8, [i32; D])>,
+    inverse: Vec<u8>,
+    /// The coverings by sublattices of `T`, systoles in the internal frame.
+    ladder: Vec<Level<D>>,
+    /// `δ(G)`: the least displacement of a non-identity element, internal frame.
+    systole: f64,
+    /// The domain is the part of `T`'s domain whose fractional coordinate along this axis
+    /// is below `1/k`.
+    slab_axis: usize,
+}
+
+fn mat_mul<const D: usize>(a: &[[i32; D]; D], b: &[[i32; D]; D]) -> [[i32; D]; D] {
+    std::array::from_fn(|i| std::array::from_fn(|j| (0..D).map(|k| a[i][k] * b[k][j]).sum()))
+}
+
+/// `o·R` for a row vector `o`.
+fn row_times<const D: usize>(o: [i32; D], r: &[[i32; D]; D]) -> [i32; D] {
+    std::array::from_fn(|j| (0..D).map(|k| o[k] * r[k][j]).sum())
+}
+
+fn det<const D: usize>(a: &[[i32; D]; D]) -> i32 {
+    match D {
+        2 => a[0][0] * a[1][1] - a[0][1] * a[1][0],
+        3 => {
+            a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1])
+                - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0])
+                + a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0])
+        }
+        _ => unreachable!("dimension 2 or 3"),
+    }
+}
+
+fn narrow<const D: usize>(o: [i32; D]) -> [i8; D] {
+    o.map(|x| i8::try_from(x).expect("lattice offset out of the 8-bit range"))
+}
+
+fn not_a_group(why: String) -> Error {
+    Error::InvalidBox(format!("not a Bieberbach group presentation: {why}"))
+}
+
+impl<const D: usize> FlatManifold<D> {
+    /// The manifold of the translations by the rows of `rows` (user units) and the coset
+    /// representatives `cosets` (the first one the identity), their translations in units of
+    /// `rows/q`. The cosets must shift along `slab_axis` by distinct multiples of `1/k` of
+    /// that lattice vector, so that the slab of `T`'s domain below `1/k` along it is a
+    /// fundamental domain.
+    pub fn new(
+        name: &'static str,
+        rows: [[f64; D]; D],
+        q: i32,
+        cosets: &[Coset<D>],
+        slab_axis: usize,
+    ) -> Result<Self> {
+        let translations = Lattice::new(rows)?;
+        let fine_rows = rows.map(|r| r.map(|x| x / q as f64));
+        let fine = FlatTorus::with_ladder(Lattice::new(fine_rows)?, Ladder::Grid);
+        if translations.unit() != fine.lattice().unit() * q as f64 {
+            return Err(Error::InvalidBox(format!(
+                "{name}: the box is too close to the limits of the doubles"
+            )));
+        }
+        let k = cosets.len();
+        if k == 0
+            || cosets[0].linear != std::array::from_fn(|i| std::array::from_fn(|j| (i == j) as i8))
+            || cosets[0].shift != [0; D]
+        {
+            return Err(not_a_group("the first coset must be the identity".into()));
+        }
+        let mut data = Vec::with_capacity(k);
+        for (c, co) in cosets.iter().enumerate() {
+            let linear = co.linear.map(|r| r.map(|x| x as i32));
+            let mut perm = [(0usize, 0.0f64); D];
+            for i in 0..D {
+                let nz: Vec<usize> = (0..D).filter(|&j| linear[i][j] != 0).collect();
+                if nz.len() != 1 || linear[i][nz[0]].abs() != 1 {
+                    return Err(not_a_group(format!(
+                        "coset {c} is not a signed permutation"
+                    )));
+                }
+                perm[i] = (nz[0], linear[i][nz[0]] as f64);
+            }
+            // R = M·Aᵀ·M⁻¹, rounded and confirmed: A maps the lattice onto itself
+            let image: [[f64; D]; D] = std::array::from_fn(|kk| {
+                std::array::from_fn(|i| (0..D).map(|j| linear[i][j] as f64 * rows[kk][j]).sum())
+            });
+            let r_f: [[f64; D]; D] = image.map(|v| translations.fractional(&v));
+            let r = r_f.map(|row| row.map(|x| x.round() as i32));
+            if r_f
+                .iter()
+                .flatten()
+                .zip(r.iter().flatten())
+                .any(|(a, b)| (a - *b as f64).abs() > 1e-6)
+            {
+                return Err(not_a_group(format!(
+                    "coset {c} does not map the lattice onto itself"
+                )));
+            }
+            data.push(CosetData {
+                perm,
+                linear,
+                r,
+                shift: co.shift,
+                reverses: det(&linear) < 0,
+            });
+        }
+        let mut product = Vec::with_capacity(k * k);
+        for a in 0..k {
+            for b in 0..k {
+                let lin = mat_mul(&data[a].linear, &data[b].linear);
+                let Some(c) = (0..k).find(|&c| data[c].linear == lin) else {
+                    return Err(not_a_group(format!(
+                        "the product of cosets {a} and {b} is no coset"
+                    )));
+                };
+                // A_a·(s_b/q·M) + s_a/q·M − s_c/q·M = κ·M
+                let num: [i32; D] = std::array::from_fn(|j| {
+                    row_times(data[b].shift, &data[a].r)[j] + data[a].shift[j] - data[c].shift[j]
+                });
+                if num.iter().any(|x| x % q != 0) {
+                    return Err(not_a_group(format!(
+                        "cosets {a}·{b} and {c} differ by no lattice vector"
+                    )));
+                }
+                product.push((c as u8, num.map(|x| x / q)));
+            }
+        }
+        let inverse = (0..k)
+            .map(|a| (0..k).find(|&b| product[a * k + b].0 == 0).map(|b| b as u8))
+            .collect::<Option<Vec<u8>>>()
+            .ok_or_else(|| not_a_group("a coset has no inverse".into()))?;
+        let ladder = translations
+            .ladder(Ladder::Grid)
+            .into_iter()
+            .map(|l| Level {
+                sub: l.sub,
+                systole: l.systole * q as f64,
+            })
+            .collect::<Vec<_>>();
+        let widest = (0..D).map(|c| ladder[0].sub.span(c)).max().unwrap_or(1);
+        if 3 * widest * q + q > 127 {
+            return Err(Error::InvalidBox(format!(
+                "{name}: the box is too elongated (its first covering needs {widest} copies along an axis)"
+            )));
+        }
+        let mut m = FlatManifold {
+            name,
+            translations,
+            fine,
+            q,
+            cosets: data,
+            product,
+            inverse,
+            ladder,
+            systole: 0.0,
+            slab_axis,
+        };
+        m.systole = m.least_displacement();
+        if m.systole.is_nan() || m.systole <= 0.0 {
+            return Err(not_a_group(
+                "an element other than the identity fixes a point".into(),
+            ));
+        }
+        Ok(m)
+    }
+
+    /// The manifold's name.
+    pub fn name(&self) -> &'static str {
+        self.name
+    }
+
+    /// The lattice of the translational subgroup `T`.
+    pub fn translations(&self) -> &Lattice<D> {
+        &self.translations
+    }
+
+    /// The index `k` of the translations in the group: the number of cosets.
+    pub fn index(&self) -> usize {
+        self.cosets.len()
+    }
+
+    /// Volume (area in 2D) of the manifold: the torus of `T`'s, over the index.
+    pub fn volume(&self) -> f64 {
+        self.translations.volume() / self.index() as f64
+    }
+
+    /// `δ(G)`, the least distance between a point and one of its other images, in user units.
+    pub fn systole(&self) -> f64 {
+        self.fine.lattice().measure_to_user(self.systole, 1)
+    }
+
+    /// Whether the manifold is orientable (no coset reverses orientation).
+    pub fn is_orientable(&self) -> bool {
+        self.cosets.iter().all(|c| !c.reverses)
+    }
+
+    /// The isometry `x ↦ A·x + t` of an element, in user units.
+    pub fn isometry(&self, g: Motion<D>) -> ([[f64; D]; D], [f64; D]) {
+        let c = &self.cosets[g.coset as usize];
+        let frac: [f64; D] =
+            std::array::from_fn(|i| (c.shift[i] + self.q * g.offset[i] as i32) as f64);
+        (
+            c.linear.map(|r| r.map(|x| x as f64)),
+            self.fine.lattice().cartesian(&frac),
+        )
+    }
+
+    /// Generators of the group as isometries: the lattice translations and the coset
+    /// representatives.
+    pub fn generators(&self) -> Vec<([[f64; D]; D], [f64; D])> {
+        let mut out: Vec<_> = (0..D)
+            .map(|i| {
+                self.isometry(Motion {
+                    coset: 0,
+                    offset: std::array::from_fn(|j| (i == j) as i8),
+                })
+            })
+            .collect();
+        out.extend((1..self.index()).map(|c| {
+            self.isometry(Motion {
+                coset: c as u8,
+                offset: [0; D],
+            })
+        }));
+        out
+    }
+
+    /// A user point in the fundamental domain, in the internal frame, and whether it moved
+    /// (`None` if it is too far away to be wrapped exactly). The point is wrapped into the
+    /// domain of `T` and the image with the least fractional coordinate along the slab axis
+    /// is kept; moving it may round, as wrapping into a torus does.
+    pub(crate) fn canonical(&self, x: [f64; D]) -> Option<([f64; D], bool)> {
+        let (y, mut moved) = self.translations.wrap(x)?;
+        let mut best = y;
+        let mut key = self.translations.fractional(&y)[self.slab_axis];
+        for c in self.cosets.iter().skip(1) {
+            // r_c⁻¹(y) = Aᵀ·(y − s/q·M)
+            let t = self.fine.lattice().cartesian(&c.shift.map(|s| s as f64));
+            let d: [f64; D] = std::array::from_fn(|i| y[i] - t[i]);
+            let mut z = [0.0; D];
+            for i in 0..D {
+                let (j, sign) = c.perm[i];
+                z[j] = sign * d[i];
+            }
+            let (z, _) = self.translations.wrap(z)?;
+            let kz = self.translations.fractional(&z)[self.slab_axis];
+            if kz < key {
+                (best, key, moved) = (z, kz, true);
+            }
+        }
+        Some((self.fine.lattice().to_internal(best), moved))
+    }
+
+    /// The lifted point `g·p` as a lifted point of the torus of `M/q`.
+    #[inline(always)]
+    fn lift(&self, (p, g): (&[f64; D], Motion<D>)) -> L<D> {
+        let c = &self.cosets[g.coset as usize];
+        let x = std::array::from_fn(|i| {
+            let (j, sign) = c.perm[i];
+            sign * p[j]
+        });
+        let t: [i32; D] = std::array::from_fn(|i| c.shift[i] + self.q * g.offset[i] as i32);
+        (x, narrow(t))
+    }
+
+    fn lift_all<const N: usize>(&self, s: &[(P<D>, Motion<D>); N]) -> [L<D>; N] {
+        std::array::from_fn(|i| self.lift((&s[i].0, s[i].1)))
+    }
+
+    fn compose_elems(&self, a: Motion<D>, b: Motion<D>) -> Motion<D> {
+        let k = self.cosets.len();
+        let (c, kappa) = self.product[a.coset as usize * k + b.coset as usize];
+        let rb = row_times(b.offset.map(|x| x as i32), &self.cosets[a.coset as usize].r);
+        Motion {
+            coset: c,
+            offset: narrow(std::array::from_fn(|j| {
+                a.offset[j] as i32 + rb[j] + kappa[j]
+            })),
+        }
+    }
+
+    fn inverse_elem(&self, a: Motion<D>) -> Motion<D> {
+        let k = self.cosets.len();
+        let ci = self.inverse[a.coset as usize];
+        let (_, kappa) = self.product[a.coset as usize * k + ci as usize];
+        let o: [i32; D] = std::array::from_fn(|j| -(a.offset[j] as i32 + kappa[j]));
+        Motion {
+            coset: ci,
+            offset: narrow(row_times(o, &self.cosets[ci as usize].r)),
+        }
+    }
+
+    /// `δ(G)` in the internal frame: an element `x ↦ A·x + t` moves points by at least the
+    /// length of `t`'s projection on the fixed space of `A` (the average of `A`'s powers),
+    /// attained there; small offsets suffice because the lattice is reduced.
+    fn least_displacement(&self) -> f64 {
+        let mut best = f64::INFINITY;
+        let span = 3i32;
+        let side = (2 * span + 1) as usize;
+        for (c, co) in self.cosets.iter().enumerate() {
+            // the projection onto the fixed space of A
+            let mut power = co.linear;
+            let mut sum = co.linear;
+            let mut order = 1;
+            while power != std::array::from_fn(|i| std::array::from_fn(|j| (i == j) as i32)) {
+                power = mat_mul(&power, &co.linear);
+                for i in 0..D {
+                    for j in 0..D {
+                        sum[i][j] += power[i][j];
+                    }
+                }
+                order += 1;
+            }
+            for idx in 0..side.pow(D as u32) {
+                let mut rem = idx;
+                let o: [i32; D] = std::array::from_fn(|_| {
+                    let v = (rem % side) as i32 - span;
+                    rem /= side;
+                    v
+                });
+                if c == 0 && o == [0; D] {
+                    continue;
+                }
+                let frac: [f64; D] = std::array::from_fn(|i| (co.shift[i] + self.q * o[i]) as f64);
+                let t = self.fine.lattice().cartesian_in(&frac);
+                let proj: [f64; D] = std::array::from_fn(|i| {
+                    (0..D).map(|j| sum[i][j] as f64 * t[j]).sum::<f64>() / order as f64
+                });
+                best = best.min(proj.iter().map(|x| x * x).sum::<f64>().sqrt());
+            }
+        }
+        best
+    }
+
+    /// The last level: the manifold itself.
+    fn quotient_level(&self) -> usize {
+        self.ladder.len()
+    }
+
+    /// The squared radius `(δ/4)²` with the torus's safety margin.
+    fn radius2_for(systole: f64) -> f64 {
+        let r = systole / 4.0 * (1.0 - 1e-7);
+        r * r
+    }
+
+    /// The position of a lifted point in the internal frame, rounded.
+    fn position(&self, p: &[f64; D], g: Motion<D>) -> [f64; D] {
+        self.fine.position(self.lift((p, g)))
+    }
+}
+
+type P<const D: usize> = [f64; D];
+
+impl<const D: usize, const N: usize> OrbitSpace<N> for FlatManifold<D>
+where
+    FlatTorus<D>: OrbitSpace<N, Point = [f64; D], Elem = [i8; D]> + UnperturbedInSphere<D, N>,
+{
+    type Point = [f64; D];
+    type Elem = Motion<D>;
+
+    #[inline]
+    fn identity(&self) -> Motion<D> {
+        Motion {
+            coset: 0,
+            offset: [0; D],
+        }
+    }
+
+    #[inline]
+    fn compose(&self, a: Motion<D>, b: Motion<D>) -> Motion<D> {
+        self.compose_elems(a, b)
+    }
+
+    #[inline]
+    fn inverse(&self, a: Motion<D>) -> Motion<D> {
+        self.inverse_elem(a)
+    }
+
+    fn reverses_orientation(&self, g: Motion<D>) -> bool {
+        self.cosets[g.coset as usize].reverses
+    }
+
+    fn euler_characteristic(&self) -> i64 {
+        0
+    }
+
+    #[inline]
+    fn orient(&self, s: &[(P<D>, Motion<D>); N]) -> Sign {
+        self.fine.orient(&self.lift_all(s))
+    }
+
+    fn in_sphere(&self, s: &[(P<D>, Motion<D>); N], q: (P<D>, Motion<D>)) -> Sign {
+        let ls = self.lift_all(s);
+        let lq = self.lift((&q.0, q.1));
+        match self.fine.in_sphere_unperturbed(&ls, lq) {
+            Sign::Zero => {
+                let at = |k: usize| if k == N { (q.0, lq) } else { (s[k].0, ls[k]) };
+                perturbed_by(
+                    &ls,
+                    lq,
+                    |t| self.fine.orient(t),
+                    |a, b| {
+                        let ((pa, la), (pb, lb)) = (at(a), at(b));
+                        match pa.partial_cmp(&pb) {
+                            Some(std::cmp::Ordering::Equal) | None => {
+                                self.fine.compare_lifted(la, lb)
+                            }
+                            Some(o) => Sign::from(o),
+                        }
+                    },
+                )
+            }
+            sign => sign,
+        }
+    }
+
+    fn cospherical(&self, s: &[(P<D>, Motion<D>); N], q: (P<D>, Motion<D>)) -> bool {
+        self.fine
+            .in_sphere_unperturbed(&self.lift_all(s), self.lift((&q.0, q.1)))
+            == Sign::Zero
+    }
+
+    fn coincide(&self, a: (P<D>, Motion<D>), b: (P<D>, Motion<D>)) -> bool {
+        self.fine
+            .coincide(self.lift((&a.0, a.1)), self.lift((&b.0, b.1)))
+    }
+
+    fn circumradius2(&self, s: &[(P<D>, Motion<D>); N]) -> f64 {
+        self.fine.circumradius2(&self.lift_all(s))
+    }
+
+    fn circumcenter(&self, s: &[(P<D>, Motion<D>); N]) -> P<D> {
+        self.fine.circumcenter(&self.lift_all(s))
+    }
+
+    fn levels(&self) -> usize {
+        self.ladder.len() + 1
+    }
+
+    fn criterion_radius2(&self, level: usize) -> f64 {
+        if level == 0 {
+            f64::INFINITY
+        } else if level == self.quotient_level() {
+            Self::radius2_for(self.systole)
+        } else {
+            Self::radius2_for(self.ladder[level].systole)
+        }
+    }
+
+    fn single_lift_radius2(&self) -> f64 {
+        4.0 * Self::radius2_for(self.systole)
+    }
+
+    fn covering_copies(&self, level: usize) -> Vec<Motion<D>> {
+        if level == self.quotient_level() {
+            return vec![OrbitSpace::<N>::identity(self)];
+        }
+        let offsets = self.ladder[level].sub.copies();
+        (0..self.cosets.len() as u8)
+            .flat_map(|coset| {
+                offsets.iter().map(move |o| Motion {
+                    coset,
+                    offset: narrow(*o),
+                })
+            })
+            .collect()
+    }
+
+    fn normalize(&self, off: &mut [Motion<D>; N], level: usize) -> bool {
+        if level < self.quotient_level() {
+            // a covering: translate by the sublattice, cosets stay
+            let mut o = off.map(|g| g.offset);
+            self.ladder[level].sub.normalize(&mut o);
+            for (g, oi) in off.iter_mut().zip(o) {
+                g.offset = oi;
+            }
+            return false;
+        }
+        // the quotient: among h = g_i⁻¹, the one giving the least sorted list of elements
+        // (unique: G is torsion-free, so no h ≠ 1 permutes a finite set of elements)
+        let mut best: Option<(Motion<D>, [Motion<D>; N])> = None;
+        for i in 0..N {
+            let h = self.inverse_elem(off[i]);
+            let mut moved = off.map(|g| self.compose_elems(h, g));
+            moved.sort_unstable();
+            if best.as_ref().is_none_or(|b| moved < b.1) {
+                best = Some((h, moved));
+            }
+        }
+        let (h, _) = best.expect("a cell has vertices");
+        if h == OrbitSpace::<N>::identity(self) {
+            return false;
+        }
+        for g in off.iter_mut() {
+            *g = self.compose_elems(h, *g);
+        }
+        self.cosets[h.coset as usize].reverses
+    }
+
+    fn dummy_points(&self) -> Vec<P<D>> {
+        // a jittered grid over T's domain, fine enough for δ(G) (see `Lattice::dummy_grid`),
+        // with a multiple of k columns along the slab axis; the columns in the slab are kept
+        // (their images fill the rest of T's domain)
+        let m = self
+            .fine
+            .lattice()
+            .rows
+            .m
+            .map(|r| r.map(|x| x * self.q as f64));
+        let k = self.cosets.len();
+        let mut n = [0usize; D];
+        for i in 0..D {
+            let len = m[i].iter().map(|x| x * x).sum::<f64>().sqrt();
+            let x = len * (D as f64).sqrt() * 2.0 * 1.04 / self.systole;
+            n[i] = (x.floor() as usize + 1).max(2);
+        }
+        n[self.slab_axis] = n[self.slab_axis].div_ceil(k) * k;
+        let keep = n[self.slab_axis] / k;
+        let total: usize = n.iter().product();
+        let mut rng = crate::sort::SplitMix::new(0x0b17_2a11);
+        let mut out = Vec::new();
+        for idx in 0..total {
+            let mut rem = idx;
+            let mut f = [0.0; D];
+            let mut inside = true;
+            for i in 0..D {
+                let g = rem % n[i];
+                rem /= n[i];
+                let jitter = 0.02 * (2.0 * rng.unit() - 1.0);
+                f[i] = (g as f64 + 0.5 + jitter) / n[i] as f64 * self.q as f64;
+                inside &= i != self.slab_axis || g < keep;
+            }
+            if inside {
+                out.push(self.fine.lattice().cartesian_in(&f));
+            }
+        }
+        out
+    }
+
+    fn sheets(&self, level: usize) -> usize {
+        if level == self.quotient_level() {
+            1
+        } else {
+            self.cosets.len() * self.ladder[level].sub.index()
+        }
+    }
+
+    fn sheet_of(&self, g: Motion<D>, level: usize) -> usize {
+        if level == self.quotient_level() {
+            0
+        } else {
+            let sub = &self.ladder[level].sub;
+            g.coset as usize * sub.index() + sub.sheet(g.offset.map(|x| x as i32))
+        }
+    }
+
+    fn near(
+        &self,
+        z: (P<D>, Motion<D>),
+        pts: &[P<D>],
+        radius: f64,
+        out: &mut Vec<(u32, Motion<D>)>,
+    ) {
+        let zc = self.position(&z.0, z.1);
+        let lat = self.fine.lattice();
+        let r = radius * (1.0 + 1e-9) + 1e-12 * self.systole;
+        let q = self.q as f64;
+        // a move of length r changes T-fractional coordinate c by at most r·|column c of M⁻¹|
+        let span: [f64; D] = std::array::from_fn(|c| {
+            let col: f64 = (0..D)
+                .map(|k| {
+                    lat.fractional_in(&std::array::from_fn(|j| (j == k) as i32 as f64))[c].powi(2)
+                })
+                .sum();
+            r * col.sqrt() / q
+        });
+        for (i, p) in pts.iter().enumerate() {
+            for coset in 0..self.cosets.len() as u8 {
+                let base = self.position(
+                    p,
+                    Motion {
+                        coset,
+                        offset: [0; D],
+                    },
+                );
+                let d: [f64; D] = std::array::from_fn(|c| zc[c] - base[c]);
+                let f = lat.fractional_in(&d).map(|x| x / q);
+                let lo: [i32; D] = std::array::from_fn(|c| (f[c] - span[c]).floor() as i32 - 1);
+                let side: [i32; D] =
+                    std::array::from_fn(|c| (f[c] + span[c]).ceil() as i32 - lo[c] + 1);
+                let total: usize = side.iter().map(|&s| s as usize).product();
+                for idx in 0..total {
+                    let mut rem = idx;
+                    let mut o = [0i32; D];
+                    for c in (0..D).rev() {
+                        o[c] = lo[c] + (rem % side[c] as usize) as i32;
+                        rem /= side[c] as usize;
+                    }
+                    let g = Motion {
+                        coset,
+                        offset: narrow(o),
+                    };
+                    let x = self.position(p, g);
+                    let d2: f64 = (0..D).map(|c| (x[c] - zc[c]).powi(2)).sum();
+                    if d2 <= r * r {
+                        out.push((i as u32, g));
+                    }
+                }
+            }
+        }
+    }
+
+    fn edge_bound(&self, level: usize) -> f64 {
+        if level == self.quotient_level() {
+            self.systole / 2.0
+        } else if level > 0 {
+            self.ladder[level].systole / 2.0
+        } else {
+            // the largest empty ball of one point of T: diameter ≤ √(Σ|b_i|²)
+            let m = &self.fine.lattice().rows.m;
+            (0..D)
+                .map(|i| {
+                    m[i].iter()
+                        .map(|x| x * x * self.q as f64 * self.q as f64)
+                        .sum::<f64>()
+                })
+                .sum::<f64>()
+                .sqrt()
+        }
+    }
+
+    fn spatial_key(&self, p: &P<D>) -> u64 {
+        let bits = if D == 3 { 21 } else { 16 };
+        let f = self.fine.lattice().fractional_in(p);
+        let scale = (1u64 << bits) as f64;
+        let cell: [u32; D] =
+            f.map(|v| ((v / self.q as f64).clamp(0.0, 1.0) * scale).min(scale - 1.0) as u32);
+        crate::sort::hilbert(cell, bits)
+    }
+}
+
+impl<const D: usize, const N: usize> FlatSpace<D, N> for FlatManifold<D>
+where
+    FlatTorus<D>: OrbitSpace<N, Point = [f64; D], Elem = [i8; D]> + UnperturbedInSphere<D, N>,
+{
+    fn canonical_point(&self, x: &[f64; D]) -> Option<([f64; D], bool)> {
+        self.canonical(*x)
+    }
+
+    fn to_user(&self, x: [f64; D]) -> [f64; D] {
+        self.fine.lattice().to_user(x)
+    }
+
+    fn measure_to_user(&self, x: f64, power: i32) -> f64 {
+        self.fine.lattice().measure_to_user(x, power)
+    }
+
+    fn lifted_position(&self, (p, g): (P<D>, Motion<D>)) -> [f64; D] {
+        self.position(&p, g)
+    }
+
+    fn lifted_difference(&self, a: (P<D>, Motion<D>), b: (P<D>, Motion<D>)) -> [f64; D] {
+        self.fine
+            .lifted_difference(self.lift((&a.0, a.1)), self.lift((&b.0, b.1)))
+    }
+
+    fn untwist(&self, g: Motion<D>, v: [f64; D]) -> [f64; D] {
+        let c = &self.cosets[g.coset as usize];
+        let mut z = [0.0; D];
+        for i in 0..D {
+            let (j, sign) = c.perm[i];
+            z[j] = sign * v[i];
+        }
+        z
+    }
+
+    fn relating(&self, from: [f64; D], to: [f64; D]) -> Option<Motion<D>> {
+        let lat = self.fine.lattice();
+        (0..self.cosets.len() as u8).find_map(|coset| {
+            let base = self.position(
+                &from,
+                Motion {
+                    coset,
+                    offset: [0; D],
+                },
+            );
+            let d: [f64; D] = std::array::from_fn(|c| to[c] - base[c]);
+            let o = lat.fractional_in(&d).map(|x| (x / self.q as f64).round());
+            if o.iter().any(|x| x.abs() > 30.0) {
+                return None;
+            }
+            let g = Motion {
+                coset,
+                offset: o.map(|x| x as i8),
+            };
+            self.fine
+                .coincide(self.lift((&from, g)), (to, [0; D]))
+                .then_some(g)
+        })
+    }
+
+    fn canonical_face(&self, pairs: &mut [(u32, Motion<D>)]) {
+        least_translate::<Self, N>(self, pairs)
+    }
+
+    fn volume(&self) -> f64 {
+        FlatManifold::volume(self)
+    }
+
+    fn check_volume_representable(&self) -> Result<()> {
+        self.translations.check_volume_representable()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn klein() -> FlatManifold<2> {
+        FlatManifold::klein_bottle(1.0, 1.0).unwrap()
+    }
+
+    #[test]
+    fn the_group_law_of_the_klein_bottle() {
+        let k = klein();
+        let s = |g| OrbitSpace::<3>::identity(&k) == g;
+        let glide = Motion {
+            coset: 1,
+            offset: [0, 0],
+        };
+        let g2 = k.compose_elems(glide, glide);
+        assert_eq!(
+            g2,
+            Motion {
+                coset: 0,
+                offset: [1, 0]
+            },
+            "γ² is the translation (2, 0)"
+        );
+        let elems: Vec<Motion<2>> = (0..2u8)
+            .flat_map(|c| {
+                (-2..=2).flat_map(move |x| {
+                    (-2..=2).map(move |y| Motion {
+                        coset: c,
+                        offset: [x, y],
+                    })
+                })
+            })
+            .collect();
+        for &a in &elems {
+            assert!(s(k.compose_elems(a, k.inverse_elem(a))));
+            assert!(s(k.compose_elems(k.inverse_elem(a), a)));
+            for &b in &elems {
+                // the composition agrees with the isometries
+                let (aa, ta) = k.isometry(a);
+                let (ab, tb) = k.isometry(b);
+                let (ac, tc) = k.isometry(k.compose_elems(a, b));
+                for i in 0..2 {
+                    for j in 0..2 {
+                        assert_eq!(ac[i][j], (0..2).map(|m| aa[i][m] * ab[m][j]).sum::<f64>());
+                    }
+                    let t = (0..2).map(|m| aa[i][m] * tb[m]).sum::<f64>() + ta[i];
+                    assert_eq!(tc[i], t);
+                }
+            }
+        }
+        assert!(!k.is_orientable());
+        assert_eq!(k.systole(), 1.0);
+        assert_eq!(k.volume(), 1.0);
+        assert!(OrbitSpace::<3>::reverses_orientation(&k, glide));
+    }
+
+    #[test]
+    fn canonical_points_lie_in_the_domain() {
+        let k = klein();
+        let (p, moved) = k.canonical([1.25, 0.25]).unwrap();
+        assert!(moved);
+        assert_eq!(k.fine.lattice().to_user(p), [0.25, 0.75]);
+        let (p, moved) = k.canonical([0.5, 0.5]).unwrap();
+        assert!(!moved);
+        assert_eq!(k.fine.lattice().to_user(p), [0.5, 0.5]);
+    }
+
+    #[test]
+    fn random_points_triangulate_the_klein_bottle() {
+        let k = klein();
+        let mut e = crate::Engine::<FlatManifold<2>, 3>::new(k.clone());
+        let mut r = crate::sort::SplitMix::new(7);
+        for n in 0..300 {
+            let (p, _) = k.canonical([r.unit() * 3.0, r.unit() * 2.0 - 0.5]).unwrap();
+            e.insert(p);
+            if n < 40 || n % 50 == 0 {
+                e.is_valid()
+                    .unwrap_or_else(|x| panic!("after {} points: {x}", n + 1));
+            }
+        }
+        assert!(e.is_one_sheeted());
+        e.is_valid().unwrap();
+        assert_eq!(e.number_of_cells(), 2 * 300);
+    }
+
+    #[test]
+    fn presentations_that_are_no_group_are_refused() {
+        let bad = FlatManifold::new(
+            "bad",
+            [[2.0, 0.0], [0.0, 1.0]],
+            2,
+            &[
+                Coset {
+                    linear: [[1, 0], [0, 1]],
+                    shift: [0, 0],
+                },
+                // a reflection without glide fixes the line y = 0
+                Coset {
+                    linear: [[1, 0], [0, -1]],
+                    shift: [0, 0],
+                },
+            ],
+            0,
+        );
+        assert!(bad.is_err());
+    }
+}
