@@ -1,6 +1,8 @@
 //! Independent checks: nothing here calls the predicates or the engine's geometry.
 #![allow(dead_code)]
 
+pub mod universal;
+
 use std::collections::HashMap;
 
 use orbitri::sort::SplitMix;
