@@ -7,8 +7,8 @@ use std::collections::HashSet;
 
 use common::universal::{check, Element, Group, Isometry, Manifold};
 use num_rational::BigRational;
-use orbitri::periodic::Torus;
 use orbitri::sort::SplitMix;
+use orbitri::triangulation::Torus;
 use orbitri::{Copies, FlatTorus, FlatTorus2, FlatTorus3, PeriodicDelaunay};
 
 type Cell<const D: usize, const N: usize> = ([u32; N], [Isometry<D>; N]);

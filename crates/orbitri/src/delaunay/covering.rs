@@ -63,6 +63,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 seeds,
                 |arr, idx| self.wrap_candidates(arr[(idx + 1) % N], radius),
                 vec![first],
+                true,
             )
             .expect("gift wrapping closes the initial triangulation");
         self.commit(&cells);
@@ -191,9 +192,14 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     }
 
     /// At the end of a construction still in the covering: switch to the quotient if it is
-    /// a triangulation even though the criterion does not guarantee it for more points.
+    /// a triangulation even though the criterion does not guarantee it for more points (a
+    /// torus only: see [`OrbitSpace::translations_only`]).
     pub fn try_one_sheet(&mut self) -> bool {
-        if !self.one_sheeted && !self.points.is_empty() && self.quotient_is_simplicial() {
+        if !self.one_sheeted
+            && !self.points.is_empty()
+            && self.space.translations_only()
+            && self.quotient_is_simplicial()
+        {
             self.convert(self.last_level());
             if self.big_count == 0 {
                 self.set_guaranteed(true);

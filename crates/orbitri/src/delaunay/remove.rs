@@ -42,7 +42,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             seeds.push((cell.v, arr, i, true, Owner::Old(d, j)));
         }
         let cells = self
-            .wrap(seeds, |_, _| hole.clone(), Vec::new())
+            .wrap(seeds, |_, _| hole.clone(), Vec::new(), false)
             .ok_or(RemoveError::NotSimplicial)?;
         let limit = self.space.criterion_radius2(self.last_level());
         let breaks = cells

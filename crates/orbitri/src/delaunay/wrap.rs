@@ -85,13 +85,18 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     }
 
     /// Closes every facet of `open` (and every facet the new cells leave open); the apex of
-    /// a facet is taken from `candidates(simplex, slot to replace)`. Returns the new cells with their links, or
-    /// `None` if some facet found no apex.
+    /// a facet is taken from `candidates(simplex, slot to replace)`. Returns the new cells
+    /// with their links, or `None` if some facet found no apex.
+    ///
+    /// With `recenter`, each new cell is moved into the canonical form of the current level
+    /// (candidates are then searched around it): wrapping a whole covering visits its cells
+    /// in a snake that may wander many periods away, and the group elements must stay small.
     pub(super) fn wrap(
         &self,
         seeds: Vec<Seed<S, N>>,
         mut candidates: impl FnMut(&LiftedCell<S, N>, usize) -> Vec<Candidate<S, N>>,
         mut first: Vec<Wrapped<S::Point, S::Elem, N>>,
+        recenter: bool,
     ) -> Option<Vec<Wrapped<S::Point, S::Elem, N>>> {
         let mut open: HashMap<[u32; N], Open<S::Point, S::Elem, N>> = HashMap::new();
         let mut queue: Vec<[u32; N]> = Vec::new();
@@ -112,20 +117,34 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         while let Some(key) = queue.pop() {
             let Some(f) = open.remove(&key) else { continue };
             let cands = candidates(&f.arr, f.idx);
-            let (vid, arr) = self.pivot(&f, &cands)?;
+            let (vid, mut arr) = self.pivot(&f, &cands)?;
             let mut vids = f.vids;
             vids[f.idx] = vid;
             if !f.toward {
                 vids.swap((f.idx + 1) % N, (f.idx + 2) % N);
             }
+            // the slot of the facet just closed
+            let mut idx = f.idx;
+            if recenter {
+                let mut off = arr.map(|x| x.1);
+                let reversed = self.space.normalize(&mut off, self.level);
+                for (a, o) in arr.iter_mut().zip(off) {
+                    a.1 = o;
+                }
+                if reversed {
+                    arr.swap(0, 1);
+                    vids.swap(0, 1);
+                    idx = [1, 0].get(idx).copied().unwrap_or(idx);
+                }
+            }
             let k = first.len();
             let mut links = [None; N];
-            links[f.idx] = Some(f.owner);
+            links[idx] = Some(f.owner);
             if let Owner::New(o, m) = f.owner {
-                first[o].links[m] = Some(Owner::New(k, f.idx));
+                first[o].links[m] = Some(Owner::New(k, idx));
             }
             for (m, link) in links.iter_mut().enumerate() {
-                if m == f.idx {
+                if m == idx {
                     continue;
                 }
                 let fk = facet_key(&vids, m);

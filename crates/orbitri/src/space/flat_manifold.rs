@@ -95,7 +95,49 @@ fn det<const D: usize>(a: &[[i32; D]; D]) -> i32 {
 }
 
 fn narrow<const D: usize>(o: [i32; D]) -> [i8; D] {
-    o.map(|x| i8::try_from(x).expect("lattice offset out of the 8-bit range"))
+    o.map(|x| {
+        i8::try_from(x).unwrap_or_else(|_| panic!("lattice offset out of the 8-bit range: {o:?}"))
+    })
+}
+
+/// Twice the largest empty-ball diameter `Δ` one point's orbit can leave, internal frame of
+/// `T`, with a relative margin: a covering by translations whose systole exceeds it
+/// triangulates every non-empty point set (Theorem 10 of Caroli–Teillaud). `Δ` is twice the
+/// covering radius `ρ` of the orbit, bounded two ways: by `T`'s alone, `½√(Σ|b_i|²)`; and
+/// by layers: the cosets map the slab domain onto the `k` layers of `T`'s domain along the
+/// slab axis, each holding a translate of the lattice of the other vectors on a plane, so a
+/// point is within the layer width `w` of that plane and within `½√(Σ_{i≠axis}|b_i|²)` of
+/// a lattice point on it.
+fn one_point_need<const D: usize>(t: &Lattice<D>, k: usize, axis: usize) -> f64 {
+    let m = &t.rows.m;
+    let sq = |r: &[f64; D]| r.iter().map(|x| x * x).sum::<f64>();
+    let rho_t = 0.5 * m.iter().map(sq).sum::<f64>().sqrt();
+    let others: Vec<&[f64; D]> = (0..D).filter(|&i| i != axis).map(|i| &m[i]).collect();
+    // the measure of the other vectors' cell: a length in 2D, an area in 3D
+    let base = if D == 2 {
+        sq(others[0]).sqrt()
+    } else {
+        let (a, b) = (others[0], others[1]);
+        let c = [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ];
+        (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt()
+    };
+    let volume = match D {
+        2 => (m[0][0] * m[1][1] - m[0][1] * m[1][0]).abs(),
+        _ => {
+            let d = |i: usize, j: usize| m[i][j];
+            (d(0, 0) * (d(1, 1) * d(2, 2) - d(1, 2) * d(2, 1))
+                - d(0, 1) * (d(1, 0) * d(2, 2) - d(1, 2) * d(2, 0))
+                + d(0, 2) * (d(1, 0) * d(2, 1) - d(1, 1) * d(2, 0)))
+            .abs()
+        }
+    };
+    let w = volume / base / k as f64;
+    let rho_layer = (w * w + 0.25 * others.iter().map(|r| sq(r)).sum::<f64>()).sqrt();
+    4.0 * rho_t.min(rho_layer) * (1.0 + 1e-9)
 }
 
 fn not_a_group(why: String) -> Error {
@@ -193,7 +235,7 @@ impl<const D: usize> FlatManifold<D> {
             .collect::<Option<Vec<u8>>>()
             .ok_or_else(|| not_a_group("a coset has no inverse".into()))?;
         let ladder = translations
-            .ladder(Ladder::Grid)
+            .grid_ladder_for(one_point_need(&translations, k, slab_axis))
             .into_iter()
             .map(|l| Level {
                 sub: l.sub,
@@ -290,12 +332,24 @@ impl<const D: usize> FlatManifold<D> {
 
     /// A user point in the fundamental domain, in the internal frame, and whether it moved
     /// (`None` if it is too far away to be wrapped exactly). The point is wrapped into the
-    /// domain of `T` and the image with the least fractional coordinate along the slab axis
-    /// is kept; moving it may round, as wrapping into a torus does.
+    /// domain of `T` and, of its `k` images there, the one with the least fractional
+    /// coordinates (the slab axis first) is kept; moving it may round, as wrapping into a
+    /// torus does.
     pub(crate) fn canonical(&self, x: [f64; D]) -> Option<([f64; D], bool)> {
         let (y, mut moved) = self.translations.wrap(x)?;
+        // the slab axis first, then the others: images tied along the axis (on a boundary
+        // of the slab) are told apart by the rest
+        let key_of = |z: &[f64; D]| {
+            let f = self.translations.fractional(z);
+            let mut k = [f[self.slab_axis]; D];
+            let others = (0..D).filter(|&i| i != self.slab_axis);
+            for (slot, i) in others.enumerate() {
+                k[slot + 1] = f[i];
+            }
+            k
+        };
         let mut best = y;
-        let mut key = self.translations.fractional(&y)[self.slab_axis];
+        let mut key = key_of(&y);
         for c in self.cosets.iter().skip(1) {
             // r_c⁻¹(y) = Aᵀ·(y − s/q·M)
             let t = self.fine.lattice().cartesian(&c.shift.map(|s| s as f64));
@@ -306,7 +360,7 @@ impl<const D: usize> FlatManifold<D> {
                 z[j] = sign * d[i];
             }
             let (z, _) = self.translations.wrap(z)?;
-            let kz = self.translations.fractional(&z)[self.slab_axis];
+            let kz = key_of(&z);
             if kz < key {
                 (best, key, moved) = (z, kz, true);
             }
@@ -439,6 +493,10 @@ where
         self.inverse_elem(a)
     }
 
+    fn translations_only(&self) -> bool {
+        self.cosets.len() == 1
+    }
+
     fn reverses_orientation(&self, g: Motion<D>) -> bool {
         self.cosets[g.coset as usize].reverses
     }
@@ -457,6 +515,10 @@ where
         let lq = self.lift((&q.0, q.1));
         match self.fine.in_sphere_unperturbed(&ls, lq) {
             Sign::Zero => {
+                // one global order: distinct points by their stored coordinates (invariant
+                // under the group), copies of one point by their lifted positions (invariant
+                // under translations: copies meet in one test only in a covering, whose
+                // group is translations)
                 let at = |k: usize| if k == N { (q.0, lq) } else { (s[k].0, ls[k]) };
                 perturbed_by(
                     &ls,

@@ -391,8 +391,13 @@ impl<const D: usize> Lattice<D> {
         if self.rows.diagonal && (0..D).all(|i| self.rows.m[i][i] == l0) {
             return ([3; D], 0);
         }
+        self.covering_search_for(self.one_point_need())
+    }
+
+    /// The diagonal covering `h` (copies per lattice vector) whose systole exceeds `big`
+    /// (internal frame), grown from below along the shortest `h_i·b_i`, and the steps taken.
+    fn covering_search_for(&self, big: f64) -> ([i32; D], usize) {
         let mut steps = 0;
-        let big = self.one_point_need();
         // start below the answer and grow the copies along the currently shortest vector
         let mut h: [i32; D] =
             std::array::from_fn(|i| ((big / norm(&self.rows.m[i])).floor() as i32).max(1));
@@ -417,6 +422,23 @@ impl<const D: usize> Lattice<D> {
     /// systole exceeds it triangulates every non-empty point set.
     fn one_point_need(&self) -> f64 {
         2.0 * self.rows.m.iter().map(|r| dot(r, r)).sum::<f64>().sqrt() * (1.0 + 1e-9)
+    }
+
+    /// The two-level ladder of a space whose translations are this lattice and whose one
+    /// point leaves empty balls of diameter below `need/2` (internal frame): the diagonal
+    /// covering whose systole exceeds `need`, then the lattice itself.
+    pub(crate) fn grid_ladder_for(&self, need: f64) -> Vec<Level<D>> {
+        let (h, _) = self.covering_search_for(need);
+        vec![
+            Level {
+                sub: Sublattice::diagonal(h),
+                systole: shortest_vector(&self.rows, &diagonal_basis(h)),
+            },
+            Level {
+                sub: Sublattice::identity(),
+                systole: self.systole,
+            },
+        ]
     }
 
     /// The coverings a triangulation passes through on its way to the torus: level 0

@@ -7,6 +7,7 @@ mod flat_torus2;
 mod flat_torus3;
 mod klein_bottle;
 mod lattice;
+mod platycosms;
 mod sublattice;
 
 pub use flat_manifold::{Coset, FlatManifold, Motion};
@@ -99,6 +100,13 @@ pub trait OrbitSpace<const N: usize>: Sync + Send {
     fn single_lift_radius2(&self) -> f64;
     /// The offsets of the copies of one point in the covering of `level` (one per sheet).
     fn covering_copies(&self, level: usize) -> Vec<Self::Elem>;
+    /// True when every element is a translation (a torus). Otherwise a covering's
+    /// triangulation is equivariant under the whole group only once the quotient's criterion
+    /// holds (its ties between copies of one point are broken by an order invariant under
+    /// translations alone), and the engine moves to the quotient only then.
+    fn translations_only(&self) -> bool {
+        true
+    }
     /// Whether the element reverses orientation (a reflection or glide reflection; never for
     /// a torus).
     fn reverses_orientation(&self, g: Self::Elem) -> bool;

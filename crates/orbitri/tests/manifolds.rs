@@ -1,0 +1,253 @@
+//! Every closed flat manifold against the independent universal-cover checker
+//! (`common/universal.rs`, exact, sharing no code with the engine), against orbitri's own
+//! torus triangulation of the unfolded point set, and through the Voronoi volumes.
+
+mod common;
+use std::collections::BTreeSet;
+
+use common::universal::{check, Isometry, Manifold};
+use orbitri::sort::SplitMix;
+use orbitri::{
+    Copies, FlatManifold, FlatSpace, FlatTorus, Motion, OrbitSpace, PeriodicDelaunay, Triangulation,
+};
+
+fn random<const D: usize>(n: usize, seed: u64, scale: [f64; D]) -> Vec<[f64; D]> {
+    let mut r = SplitMix::new(seed);
+    (0..n)
+        .map(|_| std::array::from_fn(|i| r.unit() * scale[i]))
+        .collect()
+}
+
+fn isometry<const D: usize>(m: &FlatManifold<D>, g: Motion<D>) -> Isometry<D> {
+    let (a, t) = m.isometry(g);
+    Isometry { a, t }
+}
+
+/// Checks the triangulation with the universal-cover checker and the Voronoi volumes.
+fn verify<const D: usize, const N: usize>(tri: &Triangulation<D, N, FlatManifold<D>>, what: &str)
+where
+    FlatManifold<D>: FlatSpace<D, N, Elem = Motion<D>>,
+{
+    tri.is_valid().unwrap_or_else(|e| panic!("{what}: {e}"));
+    let m = tri.space();
+    let volume: f64 = tri.voronoi_cells().iter().map(|c| c.volume).sum();
+    assert!(
+        (volume - m.volume()).abs() <= 1e-12 * m.volume(),
+        "{what}: Voronoi volumes sum to {volume}, not {}",
+        m.volume()
+    );
+    if !tri.is_one_sheeted() {
+        // a covering (a few points): valid as a triangulation of the covering space
+        return;
+    }
+    let manifold = Manifold {
+        generators: m
+            .generators()
+            .into_iter()
+            .map(|(a, t)| Isometry { a, t })
+            .collect(),
+        volume: m.volume(),
+        euler: 0,
+    };
+    let cells: Vec<([u32; N], [Isometry<D>; N])> = tri
+        .cells(Copies::Unique)
+        .iter()
+        .map(|c| {
+            (
+                c.vertices.map(|i| tri.vertex_of_input(i as usize)),
+                c.offsets.map(|g| isometry(m, g)),
+            )
+        })
+        .collect();
+    check(&manifold, &tri.points(), &cells).unwrap_or_else(|e| panic!("{what}: {e}"));
+}
+
+/// Dyadic boxes, so that every group element is exact in doubles (the checker asks it).
+const BOX: [f64; 3] = [1.0, 1.0, 1.25];
+
+#[test]
+fn klein_bottles_pass_the_universal_check() {
+    for (a, b) in [(1.0, 1.0), (0.5, 1.25), (2.0, 0.75)] {
+        for (n, seed) in [(1, 1), (4, 2), (12, 3), (150, 4), (1500, 5)] {
+            let klein = FlatManifold::klein_bottle(a, b).unwrap();
+            let tri = Triangulation::build(klein, &random(n, seed, [a, b])).unwrap();
+            verify::<2, 3>(&tri, &format!("klein {a}×{b}, {n} points"));
+        }
+    }
+}
+
+#[test]
+fn platycosms_pass_the_universal_check() {
+    for name in FlatManifold::PLATYCOSMS {
+        for (n, seed) in [(1, 1), (3, 2), (10, 3), (120, 4), (700, 5)] {
+            let m = FlatManifold::platycosm(name, BOX).unwrap();
+            let tri = Triangulation::build(m, &random(n, seed, BOX)).unwrap();
+            verify::<3, 4>(&tri, &format!("{name}, {n} points"));
+        }
+    }
+}
+
+#[test]
+fn the_groups_are_what_their_names_say() {
+    let expect = [
+        ("torocosm", 1, true),
+        ("dicosm", 2, true),
+        ("tetracosm", 4, true),
+        ("didicosm", 4, true),
+        ("first-amphicosm", 2, false),
+        ("second-amphicosm", 2, false),
+    ];
+    for (name, index, orientable) in expect {
+        let m = FlatManifold::platycosm(name, BOX).unwrap();
+        assert_eq!(
+            (m.index(), m.is_orientable()),
+            (index, orientable),
+            "{name}"
+        );
+        assert_eq!(m.volume(), 1.25, "{name}");
+        assert!(m.systole() > 0.0, "{name}: torsion-free");
+    }
+    let klein = FlatManifold::klein_bottle(1.0, 1.0).unwrap();
+    assert_eq!((klein.index(), klein.is_orientable()), (2, false));
+    assert!(FlatManifold::platycosm("tetracosm", [1.0, 2.0, 1.0]).is_err());
+    assert!(FlatManifold::platycosm("tricosm-of-mars", BOX).is_err());
+    assert!(FlatManifold::platycosm("dicosm", [1.0, 0.0, 1.0]).is_err());
+}
+
+/// The cells of a manifold lifted to the torus of its translations, on the unfolded points
+/// (each point's images under the coset representatives, wrapped), equal orbitri's torus
+/// triangulation of those points.
+fn unfolds_to_the_torus<const D: usize, const N: usize>(m: FlatManifold<D>, n: usize, seed: u64)
+where
+    FlatManifold<D>: FlatSpace<D, N, Elem = Motion<D>>,
+    FlatTorus<D>: FlatSpace<D, N, Elem = [i8; D]>,
+{
+    let what = m.name();
+    let lengths = std::array::from_fn(|i| BOX[i]);
+    let tri = Triangulation::build(m.clone(), &random(n, seed, lengths)).unwrap();
+    assert!(tri.is_one_sheeted(), "{what}");
+    let rows = m.translations().vectors();
+    let torus = FlatTorus::new(m.translations().clone());
+    let k = m.index();
+    let apply = |g: Motion<D>, p: [f64; D]| {
+        let (a, t) = m.isometry(g);
+        std::array::from_fn(|i| (0..D).map(|j| a[i][j] * p[j]).sum::<f64>() + t[i])
+    };
+    let coset = |c: usize| Motion {
+        coset: c as u8,
+        offset: [0; D],
+    };
+    let pts = tri.points();
+    // cover point c·n + v: the image of point v under coset representative c
+    let mut cover = Vec::new();
+    for c in 0..k {
+        for &p in &pts {
+            cover.push(torus.lattice().wrap(apply(coset(c), p)).unwrap().0);
+        }
+    }
+    let unfolded = PeriodicDelaunay::<D, N>::build(torus.clone(), &cover).unwrap();
+    let canon = |mut cell: Vec<(u32, [i8; D])>| {
+        FlatSpace::<D, N>::canonical_face(&torus, &mut cell);
+        cell
+    };
+    let expected: BTreeSet<Vec<(u32, [i8; D])>> = unfolded
+        .cells(Copies::Unique)
+        .iter()
+        .map(|c| canon(c.vertices.iter().copied().zip(c.offsets).collect()))
+        .collect();
+    let inv = m.translations().clone();
+    let mut lifted = BTreeSet::new();
+    for c in tri.cells(Copies::Unique) {
+        for r in 0..k {
+            let cell = (0..N)
+                .map(|j| {
+                    let v = tri.vertex_of_input(c.vertices[j] as usize);
+                    let g = OrbitSpace::<N>::compose(&m, coset(r), c.offsets[j]);
+                    let x = apply(g, pts[v as usize]);
+                    let u = g.coset as u32 * pts.len() as u32 + v;
+                    let d: [f64; D] = std::array::from_fn(|i| x[i] - cover[u as usize][i]);
+                    (u, inv.fractional(&d).map(|f| f.round() as i8))
+                })
+                .collect();
+            lifted.insert(canon(cell));
+        }
+    }
+    let _ = rows;
+    assert_eq!(lifted.len(), expected.len(), "{what}");
+    assert!(lifted == expected, "{what}: the unfolded cells differ");
+}
+
+#[test]
+fn manifolds_unfold_to_their_torus_triangulation() {
+    unfolds_to_the_torus::<2, 3>(FlatManifold::klein_bottle(1.0, 1.0).unwrap(), 300, 7);
+    for name in FlatManifold::PLATYCOSMS {
+        unfolds_to_the_torus::<3, 4>(FlatManifold::platycosm(name, BOX).unwrap(), 1500, 8);
+    }
+}
+
+/// The cells as sets of (point coordinates, element), canonical modulo the group: equal for
+/// two triangulations of one point set whatever the input order.
+fn geometry<const D: usize, const N: usize>(
+    tri: &Triangulation<D, N, FlatManifold<D>>,
+) -> BTreeSet<Vec<(Vec<u64>, Motion<D>)>>
+where
+    FlatManifold<D>: FlatSpace<D, N, Elem = Motion<D>>,
+{
+    let pts = tri.points();
+    let mut order: Vec<u32> = (0..pts.len() as u32).collect();
+    order.sort_by(|&x, &y| pts[x as usize].partial_cmp(&pts[y as usize]).unwrap());
+    let mut rank = vec![0; pts.len()];
+    for (r, &v) in order.iter().enumerate() {
+        rank[v as usize] = r as u32;
+    }
+    tri.cells(Copies::Unique)
+        .iter()
+        .map(|c| {
+            let mut pairs: Vec<(u32, Motion<D>)> = (0..N)
+                .map(|k| {
+                    (
+                        rank[tri.vertex_of_input(c.vertices[k] as usize) as usize],
+                        c.offsets[k],
+                    )
+                })
+                .collect();
+            FlatSpace::<D, N>::canonical_face(tri.space(), &mut pairs);
+            pairs
+                .iter()
+                .map(|&(r, g)| {
+                    (
+                        pts[order[r as usize] as usize].map(f64::to_bits).to_vec(),
+                        g,
+                    )
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// A cubic crystal (every cell decided by the symbolic perturbation) and random points in
+/// two orders give the same triangulation in every platycosm.
+#[test]
+fn crystals_and_orders_give_one_triangulation() {
+    let grid: Vec<[f64; 3]> = (0..8 * 8 * 10)
+        .map(|i| [i % 8, i / 8 % 8, i / 64].map(|x| (x as f64 + 0.5) * 0.125))
+        .collect();
+    for name in FlatManifold::PLATYCOSMS {
+        for pts in [grid.clone(), random(1500, 9, BOX)] {
+            let m = FlatManifold::platycosm(name, BOX).unwrap();
+            let a = Triangulation::<3, 4, _>::build(m.clone(), &pts).unwrap();
+            a.is_valid().unwrap_or_else(|e| panic!("{name}: {e}"));
+            let mut rev = pts.clone();
+            rev.reverse();
+            let b = Triangulation::<3, 4, _>::build(m, &rev).unwrap();
+            b.is_valid().unwrap_or_else(|e| panic!("{name}: {e}"));
+            assert!(a.is_one_sheeted() && b.is_one_sheeted(), "{name}");
+            assert!(
+                geometry(&a) == geometry(&b),
+                "{name}: the input order changed the cells"
+            );
+            let volume: f64 = a.voronoi_cells().iter().map(|c| c.volume).sum();
+            assert!((volume - 1.25).abs() < 1e-12, "{name}: {volume}");
+        }
+    }
+}
