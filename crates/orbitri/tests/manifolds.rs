@@ -4,11 +4,13 @@
 
 mod common;
 use std::collections::BTreeSet;
+use std::ops::ControlFlow;
 
 use common::universal::{check, Isometry, Manifold};
 use orbitri::sort::SplitMix;
 use orbitri::{
-    Copies, FlatManifold, FlatSpace, FlatTorus, Motion, OrbitSpace, PeriodicDelaunay, Triangulation,
+    BuildOptions, Copies, FlatManifold, FlatSpace, FlatTorus, Motion, OrbitSpace, PeriodicDelaunay,
+    Triangulation,
 };
 
 fn random<const D: usize>(n: usize, seed: u64, scale: [f64; D]) -> Vec<[f64; D]> {
@@ -79,7 +81,7 @@ fn klein_bottles_pass_the_universal_check() {
 #[test]
 fn platycosms_pass_the_universal_check() {
     for name in FlatManifold::PLATYCOSMS {
-        for (n, seed) in [(1, 1), (3, 2), (10, 3), (120, 4), (700, 5)] {
+        for (n, seed) in [(1, 1), (3, 2), (10, 3), (40, 4), (1500, 5)] {
             let m = FlatManifold::platycosm(name, BOX).unwrap();
             let tri = Triangulation::build(m, &random(n, seed, BOX)).unwrap();
             verify::<3, 4>(&tri, &format!("{name}, {n} points"));
@@ -96,6 +98,8 @@ fn the_groups_are_what_their_names_say() {
         ("didicosm", 4, true),
         ("first-amphicosm", 2, false),
         ("second-amphicosm", 2, false),
+        ("first-amphidicosm", 4, false),
+        ("second-amphidicosm", 4, false),
     ];
     for (name, index, orientable) in expect {
         let m = FlatManifold::platycosm(name, BOX).unwrap();
@@ -235,11 +239,22 @@ fn crystals_and_orders_give_one_triangulation() {
     for name in FlatManifold::PLATYCOSMS {
         for pts in [grid.clone(), random(1500, 9, BOX)] {
             let m = FlatManifold::platycosm(name, BOX).unwrap();
-            let a = Triangulation::<3, 4, _>::build(m.clone(), &pts).unwrap();
+            // from the dummy points, as large inputs are built (the covering path is
+            // exercised by the smaller sets above)
+            let opts = BuildOptions {
+                dummy_threshold: 500,
+                ..BuildOptions::default()
+            };
+            let build = |m: FlatManifold<3>, pts: &[[f64; 3]]| {
+                Triangulation::<3, 4, _>::build_with(m, pts, opts, |_| ControlFlow::Continue(()))
+                    .unwrap()
+            };
+            let a = build(m.clone(), &pts);
+            assert!(a.used_dummy_points(), "{name}");
             a.is_valid().unwrap_or_else(|e| panic!("{name}: {e}"));
             let mut rev = pts.clone();
             rev.reverse();
-            let b = Triangulation::<3, 4, _>::build(m, &rev).unwrap();
+            let b = build(m, &rev);
             b.is_valid().unwrap_or_else(|e| panic!("{name}: {e}"));
             assert!(a.is_one_sheeted() && b.is_one_sheeted(), "{name}");
             assert!(

@@ -4,7 +4,9 @@
 
 use std::collections::HashMap;
 
-use super::{Candidate, Engine, LiftedOf};
+use rayon::prelude::*;
+
+use super::{Candidate, Engine};
 use crate::space::OrbitSpace;
 use crate::tds::{Cell, Tds, NONE};
 
@@ -16,13 +18,36 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         p * sheets + self.space.sheet_of(o, self.level) as u32
     }
 
-    /// Candidates for gift wrapping: the lifted copies of the points near `at`, with their
-    /// vertex ids.
-    fn wrap_candidates(&self, at: LiftedOf<S, N>, radius: f64) -> Vec<Candidate<S, N>> {
-        let mut near = Vec::new();
-        self.space.near(at, &self.points, radius, &mut near);
-        near.into_iter()
-            .map(|(i, o)| (self.vertex_id(i, o), (self.points[i as usize], o)))
+    /// For every point `p`, the lifted copies within `radius` of it (at the identity): the
+    /// copies near its image `g·p` are their images by `g`, so gift wrapping asks the
+    /// space once per point, not once per facet.
+    fn copies_around(&self, radius: f64) -> Vec<Vec<(u32, S::Elem)>> {
+        let one = self.space.identity();
+        (0..self.points.len())
+            .into_par_iter()
+            .map(|i| {
+                let mut near = Vec::new();
+                self.space
+                    .near((self.points[i], one), &self.points, radius, &mut near);
+                near
+            })
+            .collect()
+    }
+
+    /// Candidates for gift wrapping around the lifted copy `(p, g)` of point `p`: the
+    /// copies near `p` moved by `g`, with their vertex ids.
+    fn wrap_candidates(
+        &self,
+        around: &[Vec<(u32, S::Elem)>],
+        p: u32,
+        g: S::Elem,
+    ) -> Vec<Candidate<S, N>> {
+        around[p as usize]
+            .iter()
+            .map(|&(i, h)| {
+                let o = self.space.compose(g, h);
+                (self.vertex_id(i, o), (self.points[i as usize], o))
+            })
             .collect()
     }
 
@@ -51,8 +76,10 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.guaranteed = false;
         self.enter_level(level);
         let radius = self.space.edge_bound(level);
-        let a = (0u32, (self.points[0], self.space.identity()));
-        let cands = self.wrap_candidates(a.1, radius);
+        let one = self.space.identity();
+        let around = self.copies_around(radius);
+        let a = (self.vertex_id(0, one), (self.points[0], one));
+        let cands = self.wrap_candidates(&around, 0, one);
         let max_r2 = (radius / 2.0) * (radius / 2.0) * (1.0 + 1e-9);
         let first = self
             .first_cell(a, &cands, max_r2)
@@ -61,7 +88,10 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         let cells = self
             .wrap(
                 seeds,
-                |arr, idx| self.wrap_candidates(arr[(idx + 1) % N], radius),
+                |vids, arr, idx| {
+                    let k = (idx + 1) % N;
+                    self.wrap_candidates(&around, self.vpoint[vids[k] as usize], arr[k].1)
+                },
                 vec![first],
                 true,
             )

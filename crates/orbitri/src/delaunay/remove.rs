@@ -28,7 +28,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         let mut hole: Vec<Candidate<S, N>> = Vec::new();
         let mut seeds = Vec::with_capacity(star.len());
         for &(c, i, shift) in &star {
-            let arr = shifted(self, c, shift);
+            let mut arr = shifted(self, c, shift);
             let cell = self.tds.cells[c as usize];
             for k in 0..N {
                 if k != i && !hole.iter().any(|h| h.0 == cell.v[k]) {
@@ -39,10 +39,18 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             let j = self.tds.cells[d as usize]
                 .mirror(c)
                 .expect("symmetric neighbours");
-            seeds.push((cell.v, arr, i, true, Owner::Old(d, j)));
+            // a star cell moved by an orientation-reversing element is negatively oriented:
+            // two of its facet's vertices change places
+            let mut v = cell.v;
+            if self.space.reverses_orientation(shift) {
+                let (a, b) = ((i + 1) % N, (i + 2) % N);
+                arr.swap(a, b);
+                v.swap(a, b);
+            }
+            seeds.push((v, arr, i, true, Owner::Old(d, j)));
         }
         let cells = self
-            .wrap(seeds, |_, _| hole.clone(), Vec::new(), false)
+            .wrap(seeds, |_, _, _| hole.clone(), Vec::new(), false)
             .ok_or(RemoveError::NotSimplicial)?;
         let limit = self.space.criterion_radius2(self.last_level());
         let breaks = cells

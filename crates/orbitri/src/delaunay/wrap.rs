@@ -85,7 +85,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     }
 
     /// Closes every facet of `open` (and every facet the new cells leave open); the apex of
-    /// a facet is taken from `candidates(simplex, slot to replace)`. Returns the new cells
+    /// a facet is taken from `candidates(vertex ids, simplex, slot to replace)`. Returns the new cells
     /// with their links, or `None` if some facet found no apex.
     ///
     /// With `recenter`, each new cell is moved into the canonical form of the current level
@@ -94,7 +94,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     pub(super) fn wrap(
         &self,
         seeds: Vec<Seed<S, N>>,
-        mut candidates: impl FnMut(&LiftedCell<S, N>, usize) -> Vec<Candidate<S, N>>,
+        mut candidates: impl FnMut(&[u32; N], &LiftedCell<S, N>, usize) -> Vec<Candidate<S, N>>,
         mut first: Vec<Wrapped<S::Point, S::Elem, N>>,
         recenter: bool,
     ) -> Option<Vec<Wrapped<S::Point, S::Elem, N>>> {
@@ -116,7 +116,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         }
         while let Some(key) = queue.pop() {
             let Some(f) = open.remove(&key) else { continue };
-            let cands = candidates(&f.arr, f.idx);
+            let cands = candidates(&f.vids, &f.arr, f.idx);
             let (vid, mut arr) = self.pivot(&f, &cands)?;
             let mut vids = f.vids;
             vids[f.idx] = vid;

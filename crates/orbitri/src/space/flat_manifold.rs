@@ -710,9 +710,14 @@ where
                 );
                 let d: [f64; D] = std::array::from_fn(|c| zc[c] - base[c]);
                 let f = lat.fractional_in(&d).map(|x| x / q);
-                let lo: [i32; D] = std::array::from_fn(|c| (f[c] - span[c]).floor() as i32 - 1);
+                // offsets o with |f − o| ≤ span per axis; the slack covers the rounding of f
+                let slack = 1e-6;
+                let lo: [i32; D] = std::array::from_fn(|c| (f[c] - span[c] - slack).ceil() as i32);
                 let side: [i32; D] =
-                    std::array::from_fn(|c| (f[c] + span[c]).ceil() as i32 - lo[c] + 1);
+                    std::array::from_fn(|c| (f[c] + span[c] + slack).floor() as i32 - lo[c] + 1);
+                if side.iter().any(|&s| s <= 0) {
+                    continue;
+                }
                 let total: usize = side.iter().map(|&s| s as usize).product();
                 for idx in 0..total {
                     let mut rem = idx;
@@ -922,6 +927,108 @@ mod tests {
         assert!(e.is_one_sheeted());
         e.is_valid().unwrap();
         assert_eq!(e.number_of_cells(), 2 * 300);
+    }
+
+    /// The first homology group `G/[G, G]` of a presentation: free rank and torsion
+    /// coefficients. Generators: the `D` lattice translations, then the cosets `1..k`;
+    /// relations: conjugating a translation by a coset (`r_c t_i r_c⁻¹ = t^{R_c,i}`) and
+    /// the product table (`r_a r_b = t^{κ(a,b)} r_{ab}`). Smith normal form by hand.
+    fn homology<const D: usize>(m: &FlatManifold<D>) -> (usize, Vec<i64>) {
+        let k = m.cosets.len();
+        let n = D + k - 1;
+        let col = |c: usize| D + c - 1;
+        let mut rows: Vec<Vec<i64>> = Vec::new();
+        for co in &m.cosets {
+            for i in 0..D {
+                let mut r = vec![0i64; n];
+                for j in 0..D {
+                    r[j] += co.r[i][j] as i64;
+                }
+                r[i] -= 1;
+                rows.push(r);
+            }
+        }
+        for a in 0..k {
+            for b in 0..k {
+                let (c, kappa) = m.product[a * k + b];
+                let mut r = vec![0i64; n];
+                for (slot, coset) in [(a, 1i64), (b, 1), (c as usize, -1)] {
+                    if slot > 0 {
+                        r[col(slot)] += coset;
+                    }
+                }
+                for j in 0..D {
+                    r[j] -= kappa[j] as i64;
+                }
+                rows.push(r);
+            }
+        }
+        // Smith normal form: diagonalize by unimodular row and column operations
+        let mut a = rows;
+        let mut diag = Vec::new();
+        let (mut top, mut left) = (0, 0);
+        while top < a.len() && left < n {
+            let pivot = (top..a.len())
+                .flat_map(|i| (left..n).map(move |j| (i, j)))
+                .filter(|&(i, j)| a[i][j] != 0)
+                .min_by_key(|&(i, j)| a[i][j].abs());
+            let Some((pi, pj)) = pivot else { break };
+            a.swap(top, pi);
+            for row in a.iter_mut() {
+                row.swap(left, pj);
+            }
+            let p = a[top][left];
+            let mut clean = true;
+            for i in top + 1..a.len() {
+                let q = a[i][left] / p;
+                for j in left..n {
+                    a[i][j] -= q * a[top][j];
+                }
+                clean &= a[i][left] == 0;
+            }
+            for j in left + 1..n {
+                let q = a[top][j] / p;
+                for i in top..a.len() {
+                    a[i][j] -= q * a[i][left];
+                }
+                clean &= a[top][j] == 0;
+            }
+            if !clean {
+                continue;
+            }
+            // the pivot must divide the rest, else fold a row into the pivot's and go on
+            if let Some(i) = (top + 1..a.len()).find(|&i| (left + 1..n).any(|j| a[i][j] % p != 0)) {
+                for j in left..n {
+                    a[top][j] += a[i][j];
+                }
+                continue;
+            }
+            diag.push(p.abs());
+            top += 1;
+            left += 1;
+        }
+        let torsion: Vec<i64> = diag.iter().copied().filter(|&d| d > 1).collect();
+        (n - diag.len(), torsion)
+    }
+
+    #[test]
+    fn first_homology_names_each_space() {
+        let b = [1.0, 1.0, 1.25];
+        let expect: [(&str, usize, &[i64]); 8] = [
+            ("torocosm", 3, &[]),
+            ("dicosm", 1, &[2, 2]),
+            ("tetracosm", 1, &[2]),
+            ("didicosm", 0, &[4, 4]),
+            ("first-amphicosm", 2, &[2]),
+            ("second-amphicosm", 2, &[]),
+            ("first-amphidicosm", 1, &[2, 2]),
+            ("second-amphidicosm", 1, &[4]),
+        ];
+        for (name, rank, torsion) in expect {
+            let m = FlatManifold::platycosm(name, b).unwrap();
+            assert_eq!(homology(&m), (rank, torsion.to_vec()), "{name}");
+        }
+        assert_eq!(homology(&klein()), (1, vec![2]), "klein");
     }
 
     #[test]

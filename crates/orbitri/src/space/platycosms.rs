@@ -11,10 +11,15 @@
 //! | didicosm | `(x + 2L1, −y + L2/2, −z)`, `(−x, y + L2/2, −z + L3/2)` | `4L1 e1, L2 e2, L3 e3` | 4 |
 //! | first amphicosm | `(x, y, z) ↦ (x + L1, −y, z)` | `2L1 e1, L2 e2, L3 e3` | 2 |
 //! | second amphicosm | `(x, y, z) ↦ (x + L1, −y, z)` | `2L1 e1, L2 e2, L2/2 e2 + L3 e3` | 2 |
+//! | first amphidicosm | `(−x, −y, z + L3/2)`, `(x + 2L1, −y, z)` | `4L1 e1, L2 e2, L3 e3` | 4 |
+//! | second amphidicosm | `(−x, −y, z + L3/2)`, `(x + 2L1, −y + L2/2, z)` | `4L1 e1, L2 e2, L3 e3` | 4 |
 //!
 //! The dicosm and the tetracosm screw along the third axis (`L3` is the length along it);
 //! the didicosm (Hantzsche–Wendt) has three screw axes, one per coordinate axis; the
-//! amphicosms glide along the first axis and reflect the second. The fundamental domain is
+//! amphicosms glide along the first axis and reflect the second; the amphidicosms screw
+//! half a turn about the third axis and glide along the first in mirrors across the second.
+//! Their first homology groups tell them apart (`Z³`, `Z ⊕ Z₂²`, `Z ⊕ Z₂`, `Z₄²`,
+//! `Z² ⊕ Z₂`, `Z²`, `Z ⊕ Z₂²`, `Z ⊕ Z₄`, in the order of the table), which the tests check. The fundamental domain is
 //! the slab of `T`'s domain below `1/index` along the axis the cosets shift (the third for
 //! the screws, the first otherwise).
 
@@ -33,13 +38,15 @@ fn diag(a: i8, b: i8, c: i8) -> [[i8; 3]; 3] {
 
 impl FlatManifold<3> {
     /// The names [`Self::platycosm`] takes.
-    pub const PLATYCOSMS: [&'static str; 6] = [
+    pub const PLATYCOSMS: [&'static str; 8] = [
         "torocosm",
         "dicosm",
         "tetracosm",
         "didicosm",
         "first-amphicosm",
         "second-amphicosm",
+        "first-amphidicosm",
+        "second-amphidicosm",
     ];
 
     /// The platycosm `name` (see the module's table) whose fundamental domain has sides
@@ -130,6 +137,33 @@ impl FlatManifold<3> {
                 &[coset(I, [0; 3]), coset(diag(1, -1, 1), [1, 0, 0])],
                 0,
             ),
+            "first-amphidicosm" | "second-amphidicosm" => {
+                // the glide also moves along y by half a period in the second
+                let glide = if name.starts_with("first") {
+                    [1, 0, 0]
+                } else {
+                    [1, 1, 0]
+                };
+                let screw = diag(-1, -1, 1);
+                let mirror = diag(1, -1, 1);
+                FlatManifold::new(
+                    if name.starts_with("first") {
+                        "first-amphidicosm"
+                    } else {
+                        "second-amphidicosm"
+                    },
+                    box_rows(4.0 * l1, l2, l3),
+                    2,
+                    &[
+                        coset(I, [0; 3]),
+                        coset(screw, [0, 0, 1]),
+                        coset(mirror, glide),
+                        // screw∘glide: x ↦ (−x − 2L1, y − L2/2·g_y, z + L3/2)
+                        coset(diag(-1, 1, 1), [-glide[0], -glide[1], 1]),
+                    ],
+                    0,
+                )
+            }
             _ => Err(Error::InvalidBox(format!(
                 "unknown flat 3-manifold {name:?}: one of {}",
                 Self::PLATYCOSMS.join(", ")
