@@ -94,10 +94,23 @@ fn det<const D: usize>(a: &[[i32; D]; D]) -> i32 {
     }
 }
 
+/// Offsets are bounded by construction; overflowing them is a bug, and it must stop the
+/// program rather than silently wrap, also in release builds.
+#[inline(always)]
 fn narrow<const D: usize>(o: [i32; D]) -> [i8; D] {
-    o.map(|x| {
-        i8::try_from(x).unwrap_or_else(|_| panic!("lattice offset out of the 8-bit range: {o:?}"))
-    })
+    let mut out = [0i8; D];
+    for c in 0..D {
+        if o[c] != o[c] as i8 as i32 {
+            overflow(o[c]);
+        }
+        out[c] = o[c] as i8;
+    }
+    out
+}
+
+#[cold]
+fn overflow(x: i32) -> ! {
+    panic!("lattice offset {x} out of the 8-bit range")
 }
 
 /// Twice the largest empty-ball diameter `Δ` one point's orbit can leave, internal frame of
@@ -384,7 +397,17 @@ impl<const D: usize> FlatManifold<D> {
         std::array::from_fn(|i| self.lift((&s[i].0, s[i].1)))
     }
 
+    #[inline]
     fn compose_elems(&self, a: Motion<D>, b: Motion<D>) -> Motion<D> {
+        if a.coset == 0 {
+            // a translation first: the offsets add
+            return Motion {
+                coset: b.coset,
+                offset: narrow(std::array::from_fn(|j| {
+                    a.offset[j] as i32 + b.offset[j] as i32
+                })),
+            };
+        }
         let k = self.cosets.len();
         let (c, kappa) = self.product[a.coset as usize * k + b.coset as usize];
         let rb = row_times(b.offset.map(|x| x as i32), &self.cosets[a.coset as usize].r);
@@ -396,7 +419,14 @@ impl<const D: usize> FlatManifold<D> {
         }
     }
 
+    #[inline]
     fn inverse_elem(&self, a: Motion<D>) -> Motion<D> {
+        if a.coset == 0 {
+            return Motion {
+                coset: 0,
+                offset: narrow(a.offset.map(|x| -(x as i32))),
+            };
+        }
         let k = self.cosets.len();
         let ci = self.inverse[a.coset as usize];
         let (_, kappa) = self.product[a.coset as usize * k + ci as usize];
@@ -491,6 +521,33 @@ where
     #[inline]
     fn inverse(&self, a: Motion<D>) -> Motion<D> {
         self.inverse_elem(a)
+    }
+
+    #[inline]
+    fn relative(&self, a: Motion<D>, b: Motion<D>) -> Motion<D> {
+        if b.coset == 0 {
+            // b⁻¹ is a translation: the offsets subtract
+            return Motion {
+                coset: a.coset,
+                offset: narrow(std::array::from_fn(|j| {
+                    a.offset[j] as i32 - b.offset[j] as i32
+                })),
+            };
+        }
+        self.compose_elems(self.inverse_elem(b), a)
+    }
+
+    #[inline]
+    fn carry(&self, from: Motion<D>, to: Motion<D>) -> Motion<D> {
+        if from.coset == 0 && to.coset == 0 {
+            return Motion {
+                coset: 0,
+                offset: narrow(std::array::from_fn(|j| {
+                    to.offset[j] as i32 - from.offset[j] as i32
+                })),
+            };
+        }
+        self.compose_elems(to, self.inverse_elem(from))
     }
 
     fn translations_only(&self) -> bool {
@@ -601,6 +658,10 @@ where
             }
             return false;
         }
+        let one = OrbitSpace::<N>::identity(self);
+        if off.iter().all(|&g| g == one) {
+            return false;
+        }
         // the quotient: among h = g_i⁻¹, the one giving the least sorted list of elements
         // (unique: G is torsion-free, so no h ≠ 1 permutes a finite set of elements)
         let mut best: Option<(Motion<D>, [Motion<D>; N])> = None;
@@ -613,7 +674,7 @@ where
             }
         }
         let (h, _) = best.expect("a cell has vertices");
-        if h == OrbitSpace::<N>::identity(self) {
+        if h == one {
             return false;
         }
         for g in off.iter_mut() {
