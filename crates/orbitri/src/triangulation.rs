@@ -625,7 +625,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     }
 
     /// The cell containing `p` (wrapped into the domain) and the offset of `p` in its frame.
-    pub fn locate(&mut self, p: [f64; D]) -> Result<(CellView<D, N, S::Elem>, S::Elem)> {
+    pub fn locate(&self, p: [f64; D]) -> Result<(CellView<D, N, S::Elem>, S::Elem)> {
         if self.number_of_vertices() == 0 {
             return Err(Error::EmptyInput);
         }

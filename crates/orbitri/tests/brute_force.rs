@@ -249,7 +249,7 @@ fn clustered_points_fall_back_from_dummies() {
 #[test]
 fn access_api() {
     let pts = uniform(400, 2, [1.0; 3]);
-    let mut tri = build(
+    let tri = build(
         FlatTorus3::cuboid([1.0; 3]).unwrap(),
         &pts,
         BuildOptions::default(),

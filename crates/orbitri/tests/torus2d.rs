@@ -433,7 +433,7 @@ fn duplicates_and_wrapping_lose_nothing_in_2d() {
 fn access_api_in_2d() {
     let lattice = Lattice::new([[1.0, 0.0], [0.5, 0.9]]).unwrap();
     let pts = uniform(&lattice, 300, 12);
-    let mut tri = PeriodicDelaunay2::build(FlatTorus::new(lattice), &pts).unwrap();
+    let tri = PeriodicDelaunay2::build(FlatTorus::new(lattice), &pts).unwrap();
     let edges = tri.edges(Copies::Unique);
     // Euler: V − E + F = 0, and each vertex's neighbour list matches the edges at it
     assert_eq!(300 + tri.number_of_cells(), edges.len());

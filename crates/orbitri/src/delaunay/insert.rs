@@ -3,6 +3,7 @@
 
 use super::{Engine, Inserted, LiftedOf};
 use crate::predicates::Sign;
+use crate::sort::SplitMix;
 use crate::space::OrbitSpace;
 use crate::tds::NONE;
 
@@ -17,13 +18,14 @@ pub(crate) enum Refused {
 impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// The cell containing the lifted point `q`, and `q`'s offset in that cell's frame.
     /// Remembering stochastic walk: never step back through the facet just crossed, and try
-    /// the facets in a random rotation.
-    pub fn locate_from(&mut self, q: LiftedOf<S, N>, start: u32) -> (u32, S::Elem) {
+    /// the facets in a random rotation drawn from `rng` (the walk's only state: the
+    /// triangulation is only read).
+    pub fn walk(&self, q: LiftedOf<S, N>, start: u32, rng: &mut SplitMix) -> (u32, S::Elem) {
         let (p, mut qo) = q;
         let mut c = start;
         let mut prev = NONE;
         'walk: loop {
-            let r = self.rng.below(N);
+            let r = rng.below(N);
             self.tds.prefetch_neighbours(c);
             let mut s = self.lifted_cell(c);
             for k in 0..N {
@@ -48,10 +50,19 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         }
     }
 
-    /// The cell containing the point (offset 0), starting from the last insertion.
-    pub fn locate(&mut self, p: S::Point) -> (u32, S::Elem) {
+    /// [`Self::walk`] with the engine's own random generator (insertion).
+    fn locate_from(&mut self, q: LiftedOf<S, N>, start: u32) -> (u32, S::Elem) {
+        let mut rng = self.rng.clone();
+        let found = self.walk(q, start, &mut rng);
+        self.rng = rng;
+        found
+    }
+
+    /// The cell containing the point (at the identity), walking from the last insertion;
+    /// it only reads the triangulation, so queries may run in parallel.
+    pub fn locate(&self, p: S::Point) -> (u32, S::Elem) {
         let (start, shift) = self.start_cell();
-        self.locate_from((p, shift), start)
+        self.walk((p, shift), start, &mut SplitMix::new(0x10ca7e))
     }
 
     /// Collects the cells whose circumsphere contains `q` (starting at `c0`, which contains

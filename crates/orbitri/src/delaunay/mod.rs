@@ -312,7 +312,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// ([`Self::slot`]), never by position.
     #[inline]
     fn canonicalize(&self, cell: &mut Cell<S::Elem, N>) {
-        if self.space.normalize(&mut cell.off, self.level) {
+        if self.space.normalize(&mut cell.off, self.level) && S::MAY_REVERSE {
             cell.swap_slots(0, 1);
         }
     }
@@ -321,6 +321,9 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// exchanged slots.
     #[inline(always)]
     fn slot(&self, c: u32, x: u32, guess: usize) -> usize {
+        if !S::MAY_REVERSE {
+            return guess;
+        }
         let cell = &self.tds.cells[c as usize];
         if cell.v[guess] == x {
             guess

@@ -498,6 +498,8 @@ fn filtered_center<const D: usize>(
 /// for FlatTorus<D>` block.
 macro_rules! flat_torus_plugin {
     ($n:literal, $d:literal) => {
+        const MAY_REVERSE: bool = false;
+
         #[inline]
         fn identity(&self) -> Self::Elem {
             [0; $d]

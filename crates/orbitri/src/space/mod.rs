@@ -100,6 +100,9 @@ pub trait OrbitSpace<const N: usize>: Sync + Send {
     fn single_lift_radius2(&self) -> f64;
     /// The offsets of the copies of one point in the covering of `level` (one per sheet).
     fn covering_copies(&self, level: usize) -> Vec<Self::Elem>;
+    /// False when no element can reverse orientation, known at compile time: the engine then
+    /// drops the slot bookkeeping of [`OrbitSpace::normalize`]'s reversals (a torus's path).
+    const MAY_REVERSE: bool = true;
     /// True when every element is a translation (a torus). Otherwise a covering's
     /// triangulation is equivariant under the whole group only once the quotient's criterion
     /// holds (its ties between copies of one point are broken by an order invariant under
