@@ -179,6 +179,26 @@ where
     let _ = rows;
     assert_eq!(lifted.len(), expected.len(), "{what}");
     assert!(lifted == expected, "{what}: the unfolded cells differ");
+    // each point's Voronoi cell is its cell in the unfolded torus, as are its images'
+    let here = tri.voronoi_cells();
+    let there = unfolded.voronoi_cells();
+    let mut at_vertex = vec![usize::MAX; unfolded.number_of_vertices()];
+    for (i, x) in there.iter().enumerate() {
+        at_vertex[unfolded.vertex_of_input(x.point as usize) as usize] = i;
+    }
+    for cell in &here {
+        let v = tri.vertex_of_input(cell.point as usize) as usize;
+        for c in 0..k {
+            let w = &there[at_vertex[unfolded.vertex_of_input(c * pts.len() + v) as usize]];
+            assert!(
+                (cell.volume - w.volume).abs() <= 1e-12 * cell.volume,
+                "{what}: point {v}: {} here, {} in the cover",
+                cell.volume,
+                w.volume
+            );
+            assert_eq!(cell.faces.len(), w.faces.len(), "{what}: point {v}");
+        }
+    }
 }
 
 #[test]
