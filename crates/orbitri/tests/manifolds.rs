@@ -115,6 +115,13 @@ fn the_groups_are_what_their_names_say() {
     assert_eq!((klein.index(), klein.is_orientable()), (2, false));
     assert!(FlatManifold::platycosm("tetracosm", [1.0, 2.0, 1.0]).is_err());
     assert!(FlatManifold::platycosm("tricosm-of-mars", BOX).is_err());
+    let e = FlatManifold::platycosm("hexacosm", BOX)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("sixth of a turn") && e.contains("didicosm"),
+        "{e}"
+    );
     assert!(FlatManifold::platycosm("dicosm", [1.0, 0.0, 1.0]).is_err());
 }
 

@@ -164,6 +164,13 @@ impl FlatManifold<3> {
                     0,
                 )
             }
+            "tricosm" | "hexacosm" => Err(Error::InvalidBox(format!(
+                "the {name} turns a hexagonal cross-section by a {} of a turn, which is \
+                 irrational in Cartesian coordinates; its exact predicates (in lattice \
+                 coordinates with an exact Gram matrix) are not in this version: one of {}",
+                if name == "tricosm" { "third" } else { "sixth" },
+                Self::PLATYCOSMS.join(", ")
+            ))),
             _ => Err(Error::InvalidBox(format!(
                 "unknown flat 3-manifold {name:?}: one of {}",
                 Self::PLATYCOSMS.join(", ")
