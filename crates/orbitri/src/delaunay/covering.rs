@@ -67,6 +67,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.big_count = 0;
         self.hint = NONE;
         self.hint_shift = self.space.identity();
+        self.copy_hints.clear();
     }
 
     /// Triangulates the current points from scratch by gift wrapping in the space of

@@ -274,7 +274,18 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 let x = self.vpoint.len() as u32;
                 self.vpoint.push(pi);
                 self.vcell.push(NONE);
-                if let Err(refused) = self.insert_lifted((p, o), x, k == 0) {
+                if let Some(&(c, v, shift)) = self.copy_hints.get(k) {
+                    if self.tds.is_alive(c) && self.tds.cells[c as usize].v == v {
+                        (self.hint, self.hint_shift) = (c, shift);
+                    }
+                }
+                let inserted = self.insert_lifted((p, o), x, k == 0);
+                let here = (self.hint, self.tds.cells[self.hint as usize].v, self.hint_shift);
+                match self.copy_hints.get_mut(k) {
+                    Some(h) => *h = here,
+                    None => self.copy_hints.push(here),
+                }
+                if let Err(refused) = inserted {
                     let Refused::Duplicate(v) = refused else {
                         unreachable!("the covering is always a triangulation")
                     };

@@ -85,6 +85,10 @@ pub struct Engine<S: OrbitSpace<N>, const N: usize> {
     /// The offsets of one point's copies in the current covering.
     copies: Vec<S::Elem>,
     hint: u32,
+    /// In a covering, per copy: a cell near the last inserted point's copy, its vertices
+    /// (a freed and reused slot fails the check) and the shift, so that each copy of the
+    /// next point walks from its own neighbourhood instead of a period away.
+    copy_hints: Vec<(u32, [u32; N], S::Elem)>,
     /// Where the last inserted point sits in the hint cell's frame, relative to its own
     /// offset: the next query (spatially close) starts its walk lifted by this translation,
     /// not a period away when the hint cell straddles the domain boundary.
@@ -112,6 +116,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             big: Vec::new(),
             big_count: 0,
             hint: 0,
+            copy_hints: Vec::new(),
             rng: SplitMix::new(0x5eed),
             scratch: Scratch::default(),
         }
