@@ -293,3 +293,32 @@ fn crystals_and_orders_give_one_triangulation() {
         }
     }
 }
+
+/// Images of the points under the generators are the same points of the manifold: each is
+/// a duplicate of its first occurrence, whatever the element (dyadic coordinates keep the
+/// images exact).
+#[test]
+fn images_under_the_group_are_duplicates() {
+    let pts: Vec<[f64; 3]> = random(60, 13, BOX)
+        .iter()
+        .map(|p| p.map(|x| (x * 1024.0).floor() / 1024.0))
+        .collect();
+    for name in FlatManifold::PLATYCOSMS {
+        let m = FlatManifold::platycosm(name, BOX).unwrap();
+        let mut all = pts.clone();
+        for (a, t) in m.generators() {
+            all.extend(pts.iter().map(|p| {
+                std::array::from_fn(|i| (0..3).map(|j| a[i][j] * p[j]).sum::<f64>() + t[i])
+            }));
+        }
+        let tri = Triangulation::<3, 4, _>::build(m.clone(), &all).unwrap();
+        tri.is_valid().unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(tri.number_of_vertices(), pts.len(), "{name}");
+        assert_eq!(tri.duplicates(), all.len() - pts.len(), "{name}");
+        let first = tri.first_occurrences();
+        assert!(
+            (0..all.len()).all(|i| first[i] as usize == i % pts.len()),
+            "{name}"
+        );
+    }
+}

@@ -280,7 +280,11 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                     }
                 }
                 let inserted = self.insert_lifted((p, o), x, k == 0);
-                let here = (self.hint, self.tds.cells[self.hint as usize].v, self.hint_shift);
+                let here = (
+                    self.hint,
+                    self.tds.cells[self.hint as usize].v,
+                    self.hint_shift,
+                );
                 match self.copy_hints.get_mut(k) {
                     Some(h) => *h = here,
                     None => self.copy_hints.push(here),
