@@ -219,7 +219,16 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     /// images once (`i < j`, or `i == j` with the shift greater than its inverse: for a
     /// torus, its first non-zero entry positive).
     pub fn voronoi_neighbors(&self) -> Vec<Neighbor<D, S::Elem>> {
-        pairs_by(&self.voronoi_cells(), |g| self.space().inverse(g))
+        self.voronoi_neighbors_of(&self.voronoi_cells())
+    }
+
+    /// The neighbour pairs of cells already computed (by [`Self::voronoi_cells`]), as
+    /// [`Self::voronoi_neighbors`] lists them.
+    pub fn voronoi_neighbors_of(
+        &self,
+        cells: &[VoronoiCell<D, S::Elem>],
+    ) -> Vec<Neighbor<D, S::Elem>> {
+        pairs_by(cells, |g| self.space().inverse(g))
     }
 
     /// The shared duals, polling `interrupt` every 1024 cells.
