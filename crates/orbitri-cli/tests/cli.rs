@@ -869,11 +869,9 @@ fn manifold_voronoi_faces_and_tables_carry_elements() {
     let sides = ["1", "1", "1.25"];
     let nb = dir.path().join("nb.csv");
     let edges = dir.path().join("e.csv");
-    let o = in_space(
+    let run = |command, extra: &[&str]| in_space(command, &input, "didicosm", &sides, extra);
+    let o = run(
         "voronoi",
-        &input,
-        "didicosm",
-        &sides,
         &[
             "--format",
             "json",
@@ -907,11 +905,8 @@ fn manifold_voronoi_faces_and_tables_carry_elements() {
     assert!(edges.starts_with("i,j,coset,offset_x,offset_y,offset_z,length\n"));
     // VTK: the cells drawn whole
     let vtu = dir.path().join("t.vtu");
-    let o = in_space(
+    let o = run(
         "triangulate",
-        &input,
-        "didicosm",
-        &sides,
         &["--format", "vtu", "-o", vtu.to_str().unwrap()],
     );
     assert!(o.status.success(), "{}", stderr(&o));
@@ -935,48 +930,23 @@ fn bad_spaces_and_boxes_get_a_clear_error_and_exit_code_2() {
     let dir = tempfile::tempdir().unwrap();
     let p2 = generated(dir.path(), 10, 2, 1);
     let p3 = generated(dir.path(), 10, 3, 1);
-    let cases: Vec<(&Path, &str, Vec<&str>, &str)> = vec![
-        (
-            &p3,
-            "mobius",
-            vec!["1", "1", "1"],
-            "invalid value 'mobius' for '--space",
-        ),
-        (
-            &p2,
-            "klein",
-            vec!["1", "1", "1"],
-            "--space klein takes --box L1 L2, not 3 lengths",
-        ),
-        (
-            &p3,
-            "dicosm",
-            vec!["1", "1"],
-            "--space dicosm takes --box L1 L2 L3, not 2 lengths",
-        ),
-        (
-            &p3,
-            "tetracosm",
-            vec!["1", "2", "1"],
-            "invalid box: the tetracosm turns a square cross-section: L1 = L2 needed, got 1 and 2",
-        ),
-        (
-            &p2,
-            "klein",
-            vec!["1", "-1"],
-            "invalid box: the Klein bottle needs two positive finite sides",
-        ),
-        (
-            &p3,
-            "didicosm",
-            vec!["1", "0", "1"],
-            "invalid box: the didicosm needs three positive finite sides",
-        ),
+    // `NAME SIDES…: message`
+    let cases = [
+        "mobius 1 1 1: invalid value 'mobius' for '--space",
+        "klein 1 1 1: --space klein takes --box L1 L2, not 3 lengths",
+        "dicosm 1 1: --space dicosm takes --box L1 L2 L3, not 2 lengths",
+        "tetracosm 1 2 1: invalid box: the tetracosm turns a square cross-section: L1 = L2 needed",
+        "klein 1 -1: invalid box: the Klein bottle needs two positive finite sides",
+        "didicosm 1 0 1: invalid box: the didicosm needs three positive finite sides",
     ];
-    for (input, name, sides, msg) in cases {
-        let o = in_space("triangulate", input, name, &sides, &[]);
-        assert_eq!(o.status.code(), Some(2), "{name} {sides:?}");
-        assert!(stderr(&o).contains(msg), "{name} {sides:?}: {}", stderr(&o));
+    for case in cases {
+        let (args, msg) = case.split_once(": ").unwrap();
+        let mut args: Vec<&str> = args.split(' ').collect();
+        let input = if args.len() == 3 { &p2 } else { &p3 };
+        let name = args.remove(0);
+        let o = in_space("triangulate", input, name, &args, &[]);
+        assert_eq!(o.status.code(), Some(2), "{case}");
+        assert!(stderr(&o).contains(msg), "{case}: {}", stderr(&o));
     }
     // names the command knows and the library does not triangulate yet: its typed error,
     // naming the ones it does
