@@ -228,7 +228,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         &self,
         cells: &[VoronoiCell<D, S::Elem>],
     ) -> Vec<Neighbor<D, S::Elem>> {
-        pairs_by(cells, |g| self.space().inverse(g))
+        neighbor_pairs_by(cells, |g| self.space().inverse(g))
     }
 
     /// The shared duals, polling `interrupt` every 1024 cells.
@@ -550,12 +550,12 @@ fn order_polygon<const D: usize, E>(vertices: &mut Vec<[f64; D]>, faces: &mut [V
 /// The neighbour pairs of a torus's cells, each unordered pair of images once: `i < j`, or
 /// `i == j` with the shift's first non-zero entry positive.
 pub fn neighbor_pairs<const D: usize>(cells: &[VoronoiCell<D>]) -> Vec<Neighbor<D>> {
-    pairs_by(cells, |s| s.map(|x| -x))
+    neighbor_pairs_by(cells, |s| s.map(|x| -x))
 }
 
-/// The neighbour pairs, each unordered pair of images once: `i < j`, or `i == j` with the
-/// shift greater than its inverse.
-fn pairs_by<const D: usize, E: Copy + Ord>(
+/// The neighbour pairs of any space's cells, each unordered pair of images once: `i < j`, or
+/// `i == j` with the shift greater than its `inverse` (the space's).
+pub fn neighbor_pairs_by<const D: usize, E: Copy + Ord>(
     cells: &[VoronoiCell<D, E>],
     inverse: impl Fn(E) -> E,
 ) -> Vec<Neighbor<D, E>> {
