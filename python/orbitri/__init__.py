@@ -1,7 +1,9 @@
 """Exact periodic Delaunay triangulations and Voronoi cells of 2D and 3D point sets.
 
-The domain is a flat torus: a periodic box of any lattice. Every geometric decision is
-exact, and degenerate inputs (crystals, grids, duplicates) are handled, not rejected.
+The domain is a flat torus, a periodic box of any lattice (``PeriodicDelaunay``), or a
+closed flat manifold: the Klein bottle or a flat 3-manifold (``Triangulation`` with a
+``KleinBottle`` or ``FlatManifold`` space). Every geometric decision is exact, and
+degenerate inputs (crystals, grids, duplicates) are handled, not rejected.
 
 >>> import numpy as np, orbitri
 >>> rng = np.random.default_rng(1)
@@ -18,10 +20,21 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._orbitri import PLATYCOSMS as _PLATYCOSMS
+from ._orbitri import Space as _Space
 from ._orbitri import Triangulation as _Triangulation
 from ._orbitri import Voronoi, __version__
 
-__all__ = ["PeriodicDelaunay", "Voronoi", "lattice_matrix", "periodic_voronoi", "__version__"]
+__all__ = [
+    "FlatManifold",
+    "KleinBottle",
+    "PeriodicDelaunay",
+    "Triangulation",
+    "Voronoi",
+    "lattice_matrix",
+    "periodic_voronoi",
+    "__version__",
+]
 
 
 def lattice_matrix(box, dimension: int) -> np.ndarray:
@@ -120,41 +133,13 @@ def _points(points, dimension=None) -> np.ndarray:
     return p
 
 
-class PeriodicDelaunay:
-    """The Delaunay triangulation of points in a periodic box (2D or 3D, from the points'
-    shape), exact for every input.
+class _Delaunay:
+    """What every triangulation offers: ``PeriodicDelaunay`` (a torus) and ``Triangulation``
+    (a closed flat manifold). Group elements, where they appear, are a torus's offsets (N ×
+    D) and a manifold's ``(cosets, offsets)`` (N and N × D)."""
 
-    Points outside the box are wrapped into it; a point that coincides with an earlier one
-    (also through a period) is a duplicate: it maps to its first occurrence and is listed in
-    ``duplicates``. Construction runs without holding the interpreter, and Ctrl-C stops it
-    (``KeyboardInterrupt``) within a fraction of a second.
-
-    freud's 2D systems (a 2D box, N × 3 points whose last column is 0) are 2D: a box that is
-    2D by itself (``[Lx, Ly]``, a 2 × 2 matrix, a ``freud.box.Box`` with ``is2D``) takes the
-    first two columns of such points; a non-zero third coordinate is an error, and so are 2D
-    points in a 3D box.
-
-    One object may be used from several threads: reads run together, ``insert``, ``locate``
-    and ``try_one_sheet`` one at a time, each waiting without holding the interpreter.
-
-    Arrays follow ``scipy.spatial.Delaunay``: ``simplices`` (C × (D+1) input ids, positively
-    oriented), ``offsets`` (C × (D+1) × D: vertex ``k`` of simplex ``c`` lies at
-    ``points[simplices[c, k]] + offsets[c, k] @ lattice``), ``neighbors`` (C × (D+1): the
-    simplex opposite each vertex). While the points are too few for the torus
-    (``sheets > 1``), these list every simplex of the covering space.
-
-    >>> import orbitri
-    >>> tri = orbitri.PeriodicDelaunay([[0.1, 0.2], [0.6, 0.4], [0.3, 0.8], [0.8, 0.9]] * 10
-    ...                                + [[0.05 * i, 0.5] for i in range(20)], [1.0, 1.0])
-    >>> int(tri.duplicates[4]), tri.simplices.shape[1]
-    (0, 3)
-    >>> orbitri.PeriodicDelaunay([[0.1, 0.2, 0.0], [0.6, 0.7, 0.0]], [1.0, 1.0]).dimension
-    2
-    """
-
-    def __init__(self, points, box):
-        p = _points(points, _box(box)[1])
-        self._tri = _Triangulation(p, lattice_matrix(box, p.shape[1]))
+    def __init__(self, core):
+        self._tri = core
         self._cells = None
 
     def _arrays(self):
@@ -173,11 +158,6 @@ class PeriodicDelaunay:
         return self._tri.dimension
 
     @property
-    def lattice(self) -> np.ndarray:
-        """The lattice vectors (rows)."""
-        return self._tri.lattice
-
-    @property
     def points(self) -> np.ndarray:
         """The input points wrapped into the domain (N × D), in input order."""
         return self._tri.points
@@ -188,26 +168,26 @@ class PeriodicDelaunay:
         return self._arrays()[0]
 
     @property
-    def offsets(self) -> np.ndarray:
-        """Lattice offsets of the simplices' vertices (C × (D+1) × D)."""
-        return self._arrays()[1]
-
-    @property
     def neighbors(self) -> np.ndarray:
         """The simplex opposite each vertex of every simplex (C × (D+1))."""
         return self._arrays()[2]
 
     @property
     def sheets(self) -> int:
-        """1 once the triangulation is one of the torus; more for too few points."""
+        """1 once the triangulation is one of the space; more for too few points."""
         return self._tri.sheets
 
     @property
     def is_one_sheeted(self) -> bool:
         return self._tri.is_one_sheeted
 
+    def is_valid(self) -> bool:
+        """Checks the triangulation exactly: combinatorics, orientation, the empty-sphere
+        property and the Euler characteristic (without holding the interpreter)."""
+        return self._tri.is_valid()
+
     def try_one_sheet(self) -> bool:
-        """Moves a triangulation still in a covering space (``sheets > 1``) to the torus if
+        """Moves a triangulation still in a covering space (``sheets > 1``) to the space if
         its projection there is already a simplicial complex; returns ``is_one_sheeted``.
 
         The construction does this at its end; after ``insert`` it is the caller's choice:
@@ -268,30 +248,212 @@ class PeriodicDelaunay:
         return self._tri.insert(_points(points, self.dimension))
 
     def locate(self, point):
-        """The simplex containing ``point``: (vertex ids, their offsets, the point's offset
-        in that simplex's frame)."""
+        """The simplex containing ``point``: (vertex ids, their elements, the point's
+        element in that simplex's frame)."""
         q = [float(x) for x in point]
         if len(q) == 3 and self.dimension == 2:
             q = _points([q], 2)[0].tolist()
         return self._tri.locate(q)
 
     def edges(self):
-        """The Delaunay edges, each once: (pairs E × 2, shifts E × D, lengths E); the
-        second point's image is ``points[j] + shift @ lattice``."""
+        """The Delaunay edges, each once: (pairs E × 2, elements, lengths E); the second
+        point's image is ``points[j]`` moved by the element (in a torus ``points[j] + shift
+        @ lattice``)."""
         return self._tri.edges()
 
     def vertex_neighbors(self, i: int):
-        """The Delaunay neighbours of input point ``i``: (ids, shifts).
+        """The Delaunay neighbours of input point ``i``: (ids, elements).
 
         ``i`` is an integer (Python's or numpy's; a float or a string is a ``TypeError``)
         from 0 to ``number_of_input_points - 1``, else ``IndexError`` (no negative ids)."""
         return self._tri.vertex_neighbors(i)
 
     def voronoi(self) -> Voronoi:
-        """The periodic Voronoi cells (volumes, neighbours with shifts and face areas,
+        """The Voronoi cells (volumes, neighbours with their elements and face areas,
         centroids, and the cells themselves on demand). Computed without holding the
         interpreter; Ctrl-C stops it."""
         return self._tri.voronoi()
+
+
+class PeriodicDelaunay(_Delaunay):
+    """The Delaunay triangulation of points in a periodic box (2D or 3D, from the points'
+    shape), exact for every input.
+
+    Points outside the box are wrapped into it; a point that coincides with an earlier one
+    (also through a period) is a duplicate: it maps to its first occurrence and is listed in
+    ``duplicates``. Construction runs without holding the interpreter, and Ctrl-C stops it
+    (``KeyboardInterrupt``) within a fraction of a second.
+
+    freud's 2D systems (a 2D box, N × 3 points whose last column is 0) are 2D: a box that is
+    2D by itself (``[Lx, Ly]``, a 2 × 2 matrix, a ``freud.box.Box`` with ``is2D``) takes the
+    first two columns of such points; a non-zero third coordinate is an error, and so are 2D
+    points in a 3D box.
+
+    One object may be used from several threads: reads run together, ``insert``, ``locate``
+    and ``try_one_sheet`` one at a time, each waiting without holding the interpreter.
+
+    Arrays follow ``scipy.spatial.Delaunay``: ``simplices`` (C × (D+1) input ids, positively
+    oriented), ``offsets`` (C × (D+1) × D: vertex ``k`` of simplex ``c`` lies at
+    ``points[simplices[c, k]] + offsets[c, k] @ lattice``), ``neighbors`` (C × (D+1): the
+    simplex opposite each vertex). While the points are too few for the torus
+    (``sheets > 1``), these list every simplex of the covering space. The elements of
+    ``locate``, ``edges`` and ``vertex_neighbors`` are offsets too.
+
+    >>> import orbitri
+    >>> tri = orbitri.PeriodicDelaunay([[0.1, 0.2], [0.6, 0.4], [0.3, 0.8], [0.8, 0.9]] * 10
+    ...                                + [[0.05 * i, 0.5] for i in range(20)], [1.0, 1.0])
+    >>> int(tri.duplicates[4]), tri.simplices.shape[1]
+    (0, 3)
+    >>> orbitri.PeriodicDelaunay([[0.1, 0.2, 0.0], [0.6, 0.7, 0.0]], [1.0, 1.0]).dimension
+    2
+    """
+
+    def __init__(self, points, box):
+        p = _points(points, _box(box)[1])
+        super().__init__(_Triangulation(p, lattice_matrix(box, p.shape[1])))
+
+    @property
+    def lattice(self) -> np.ndarray:
+        """The lattice vectors (rows)."""
+        return self._tri.lattice
+
+    @property
+    def offsets(self) -> np.ndarray:
+        """Lattice offsets of the simplices' vertices (C × (D+1) × D)."""
+        return self._arrays()[1]
+
+
+def _of_space(attribute: str, doc: str) -> property:
+    """A read-only property of a ``FlatManifold``: its core's."""
+    return property(lambda self: getattr(self._space, attribute), doc=doc)
+
+
+class FlatManifold:
+    """A closed flat manifold: ``"klein"``, the Klein bottle of sides ``[a, b]`` (see
+    ``KleinBottle``), or a flat 3-manifold of ``PLATYCOSMS`` whose standard domain has
+    sides ``[L1, L2, L3]`` (the tetracosm needs ``L1 == L2``). A name or box the library
+    cannot take is a ``ValueError`` naming the ones it can.
+
+    Its group acts by isometries ``x ↦ A·x + t``: an element is a coset (of the translations,
+    ``0 ≤ coset < index``) and an integer offset (in units of the ``translations``).
+
+    >>> import orbitri
+    >>> hw = orbitri.FlatManifold("didicosm", [1.0, 1.0, 1.25])
+    >>> hw.index, hw.is_orientable, hw.volume
+    (4, True, 1.25)
+    >>> A, t = hw.isometry(2, [0, 0, 0])
+    >>> A.tolist(), t.tolist()
+    ([[-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, -1.0]], [0.0, 0.5, 0.625])
+    """
+
+    #: The flat 3-manifolds the library triangulates.
+    PLATYCOSMS = tuple(_PLATYCOSMS)
+
+    def __init__(self, name: str, box):
+        self._sides = [float(x) for x in np.asarray(box, dtype=float).ravel()]
+        self._space = _Space(str(name), self._sides)
+
+    def __repr__(self) -> str:
+        return f"FlatManifold({self.name!r}, {self._sides})"
+
+    name = _of_space("name", "``klein`` or the platycosm's name.")
+    dimension = _of_space("dimension", "2 (the Klein bottle) or 3.")
+    index = _of_space("index", "The number of cosets of the translations in the group.")
+    volume = _of_space("volume", "Volume (area in 2D) of the manifold: that of its domain.")
+    is_orientable = _of_space("is_orientable", "Whether no element reverses orientation.")
+    systole = _of_space("systole", "The least distance between a point and another of its images.")
+    translations = _of_space("translations", "The lattice of the group's translations (rows, D × D).")
+    generators = _of_space(
+        "generators",
+        "The group's generators as isometries ``(A, t)``, ``A`` (G × D × D) and ``t`` (G × D): "
+        "the ``D`` translations, then the representatives of cosets 1, 2, …",
+    )
+
+    def isometry(self, coset, offset):
+        """The isometries ``x ↦ A·x + t`` of the elements ``(coset, offset)``: for cosets
+        of any shape ``S`` and offsets of shape ``S + (D,)``, ``A`` of shape ``S + (D, D)``
+        and ``t`` of shape ``S + (D,)``. A coset or offset that does not exist is a
+        ``ValueError``."""
+        c = np.asarray(coset, dtype=np.int64)
+        o = np.asarray(offset, dtype=np.int64)
+        d = self.dimension
+        if o.shape != c.shape + (d,):
+            raise ValueError(f"cosets of shape {c.shape} need offsets of shape {c.shape + (d,)}, not {o.shape}")
+        a, t = self._space.isometries(c.reshape(-1), o.reshape(-1, d))
+        return a.reshape(c.shape + (d, d)), t.reshape(c.shape + (d,))
+
+
+class KleinBottle(FlatManifold):
+    """The Klein bottle of the rectangle ``[0, a) × [0, b)``: its group is generated by the
+    glide reflection ``(x, y) ↦ (x + a, −y)`` and the translation ``(x, y) ↦ (x, y + b)``.
+
+    >>> import orbitri
+    >>> k = orbitri.KleinBottle(1.0, 0.5)
+    >>> k.index, k.is_orientable, k.volume, k.translations.tolist()
+    (2, False, 0.5, [[2.0, 0.0], [0.0, 0.5]])
+    """
+
+    def __init__(self, a: float, b: float):
+        super().__init__("klein", [a, b])
+
+    def __repr__(self) -> str:
+        return f"KleinBottle({self._sides[0]}, {self._sides[1]})"
+
+
+class Triangulation(_Delaunay):
+    """The Delaunay triangulation of points in a closed flat manifold: a Klein bottle or a
+    flat 3-manifold (``space``, a ``KleinBottle`` or a ``FlatManifold``), exact for every
+    input.
+
+    It offers what ``PeriodicDelaunay`` offers, with group elements where a torus has
+    offsets: ``elements`` is ``(cosets, offsets)``, of shapes C × (D+1) and C × (D+1) × D,
+    and vertex ``k`` of simplex ``c`` lies at ``A·points[simplices[c, k]] + t`` for the
+    isometry ``(A, t) = space.isometry(cosets[c, k], offsets[c, k])``;
+    ``elements_as_isometries()`` gives them all at once. ``locate``, ``edges``,
+    ``vertex_neighbors`` and ``voronoi().neighbors()`` give ``(cosets, offsets)`` as their
+    elements; a Voronoi face's ``element`` is ``(coset, offset)``. Points are wrapped into
+    the space's domain; simplices are positively oriented once lifted (counter-clockwise in
+    2D), also through elements that reverse orientation.
+
+    >>> import numpy as np, orbitri
+    >>> klein = orbitri.KleinBottle(1.0, 0.5)
+    >>> pts = np.random.default_rng(3).random((1000, 2)) * [1.0, 0.5]
+    >>> tri = orbitri.Triangulation(pts, space=klein)
+    >>> tri.is_valid(), tri.sheets, len(tri.simplices)
+    (True, 1, 2000)
+    >>> A, t = tri.elements_as_isometries()
+    >>> lifted = np.einsum("ckij,ckj->cki", A, tri.points[tri.simplices]) + t
+    >>> bool((np.linalg.det(lifted[:, 1:] - lifted[:, :1]) > 0).all())
+    True
+    >>> bool(abs(tri.voronoi().volumes.sum() - klein.volume) < 1e-12)
+    True
+    """
+
+    def __init__(self, points, space: FlatManifold):
+        if not isinstance(space, FlatManifold):
+            raise TypeError(
+                f"space must be a FlatManifold or a KleinBottle, not {type(space).__name__} "
+                f"(for a periodic box use PeriodicDelaunay)"
+            )
+        self.space = space
+        super().__init__(_Triangulation.in_manifold(_points(points, space.dimension), space._space))
+
+    @property
+    def elements(self):
+        """The group elements of the simplices' vertices: ``(cosets, offsets)``, C × (D+1)
+        and C × (D+1) × D."""
+        return self._arrays()[1]
+
+    def elements_as_isometries(self):
+        """The elements of the simplices' vertices as isometries ``x ↦ A·x + t``: ``A``
+        (C × (D+1) × D × D) and ``t`` (C × (D+1) × D)."""
+        return self.space.isometry(*self.elements)
+
+    def locate(self, point):
+        """The simplex containing ``point``: (vertex ids, their elements ``(cosets,
+        offsets)``, the point's element ``(coset, offset)`` in that simplex's frame)."""
+        vertices, elements, (coset, offset) = super().locate(point)
+        return vertices, elements, (int(coset), offset)
 
 
 def periodic_voronoi(points, box) -> Voronoi:

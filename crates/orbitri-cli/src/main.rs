@@ -8,20 +8,18 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
+use clap::builder::PossibleValuesParser;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
-use orbitri::io::SvgOptions;
+use orbitri::io::{Drawable, SpaceFormat, SvgOptions};
 use orbitri::sort::SplitMix;
-use orbitri::triangulation::Torus;
-use orbitri::{
-    BuildOptions, FlatTorus, FlatTorus2, FlatTorus3, PeriodicDelaunay, PeriodicDelaunay2,
-};
+use orbitri::{BuildOptions, FlatManifold, FlatSpace, FlatTorus2, FlatTorus3, Triangulation};
 
 #[derive(Parser)]
 #[command(
     name = "orbitri",
     version,
-    about = "Exact periodic Delaunay triangulations (2D and 3D flat tori with any lattice)"
+    about = "Exact periodic Delaunay triangulations (2D and 3D flat tori with any lattice, the Klein bottle, the flat 3-manifolds)"
 )]
 struct Cli {
     #[command(subcommand)]
@@ -31,8 +29,8 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Triangulate the points of INPUT (text: one `x y z` or `x y` per line, `#` comments,
-    /// commas or blanks; or `.npy`: float64, N×3 or N×2) in a periodic box or lattice; the
-    /// dimension is that of the box.
+    /// commas or blanks; or `.npy`: float64, N×3 or N×2) in a periodic box or lattice, or in
+    /// the closed flat manifold `--space`; the dimension is that of the box.
     Triangulate {
         /// Input file (text or .npy)
         input: PathBuf,
@@ -66,7 +64,8 @@ enum Command {
         stats: bool,
     },
     /// Draw the periodic Delaunay triangulation and Voronoi diagram of 2D points over copies
-    /// of the domain, to SVG (or PNG for a `.png` output name).
+    /// of the domain (in a Klein bottle: its images, every other column reflected), to SVG
+    /// (or PNG for a `.png` output name).
     Draw {
         /// Input file (text or .npy, 2 coordinates per point)
         input: PathBuf,
@@ -115,9 +114,37 @@ enum Command {
     },
 }
 
+/// The names `--space` takes: the torus, the Klein bottle and the ten closed flat
+/// 3-manifolds (the library says which of these it triangulates).
+const SPACES: [&str; 12] = [
+    "torus",
+    "klein",
+    "torocosm",
+    "dicosm",
+    "tricosm",
+    "tetracosm",
+    "hexacosm",
+    "didicosm",
+    "first-amphicosm",
+    "second-amphicosm",
+    "first-amphidicosm",
+    "second-amphidicosm",
+];
+
+#[derive(Args)]
+struct Domain {
+    /// The orbit space: a flat torus (default), the Klein bottle (2D: --box L1 L2, the glide
+    /// along the first axis) or a closed flat 3-manifold (--box L1 L2 L3, the sides of its
+    /// standard domain)
+    #[arg(long, value_name = "NAME", default_value = "torus", value_parser = PossibleValuesParser::new(SPACES))]
+    space: String,
+    #[command(flatten)]
+    extent: Extent,
+}
+
 #[derive(Args)]
 #[group(required = true, multiple = false)]
-struct Domain {
+struct Extent {
     /// Box lengths: the domain is [0,LX) × [0,LY) × [0,LZ), or [0,LX) × [0,LY) in 2D
     #[arg(long = "box", num_args = 2..=3, value_names = ["LX", "LY", "LZ"], value_parser = number, allow_negative_numbers = true)]
     box_lengths: Option<Vec<f64>>,
@@ -142,9 +169,11 @@ struct Output {
 
 #[derive(Clone, Copy, ValueEnum)]
 enum Format {
-    /// `SHEETS V C`, then per cell D+1 input ids and D+1 offsets (D integers each)
+    /// `SHEETS V C`, then per cell D+1 input ids and D+1 offsets (D integers each; in a
+    /// manifold D+1 elements: coset and offset, 1+D integers each)
     Cells,
-    /// JSON with lattice, wrapped points, first occurrences, cells and offsets
+    /// JSON with lattice (manifold: space and group), wrapped points, first occurrences,
+    /// cells and offsets (manifold: elements as isometries)
     Json,
     /// VTK UnstructuredGrid (ParaView): one copy of each cell, drawn whole
     Vtu,
@@ -179,35 +208,76 @@ enum CliError {
     Render { path: PathBuf, message: String },
 }
 
-/// The torus of the command line, of either dimension.
+/// The space of the command line.
 enum Space {
-    Two(FlatTorus2),
-    Three(FlatTorus3),
+    Torus2(FlatTorus2),
+    Torus3(FlatTorus3),
+    Klein(FlatManifold<2>),
+    Manifold3(FlatManifold<3>),
+}
+
+/// Calls the generic function `$f` with the space of either kind and dimension first.
+macro_rules! with_space {
+    ($space:expr, $f:ident($($arg:expr),*)) => {
+        match $space {
+            Space::Torus2(s) => $f::<2, 3, _>(s, $($arg),*),
+            Space::Torus3(s) => $f::<3, 4, _>(s, $($arg),*),
+            Space::Klein(s) => $f::<2, 3, _>(s, $($arg),*),
+            Space::Manifold3(s) => $f::<3, 4, _>(s, $($arg),*),
+        }
+    };
 }
 
 fn space(domain: &Domain) -> Result<Space, CliError> {
-    if let Some(b) = &domain.box_lengths {
+    match domain.space.as_str() {
+        "torus" => torus(&domain.extent),
+        name => manifold(name, &domain.extent),
+    }
+}
+
+fn torus(extent: &Extent) -> Result<Space, CliError> {
+    if let Some(b) = &extent.box_lengths {
         return Ok(match b.len() {
-            2 => Space::Two(FlatTorus2::cuboid([b[0], b[1]])?),
-            _ => Space::Three(FlatTorus3::cuboid([b[0], b[1], b[2]])?),
+            2 => Space::Torus2(FlatTorus2::cuboid([b[0], b[1]])?),
+            _ => Space::Torus3(FlatTorus3::cuboid([b[0], b[1], b[2]])?),
         });
     }
-    let l = domain
+    let l = extent
         .lattice
         .as_ref()
         .expect("clap requires --box or --lattice");
     match l.len() {
-        4 => Ok(Space::Two(FlatTorus2::triclinic([
+        4 => Ok(Space::Torus2(FlatTorus2::triclinic([
             [l[0], l[1]],
             [l[2], l[3]],
         ])?)),
-        9 => Ok(Space::Three(FlatTorus3::triclinic([
+        9 => Ok(Space::Torus3(FlatTorus3::triclinic([
             [l[0], l[1], l[2]],
             [l[3], l[4], l[5]],
             [l[6], l[7], l[8]],
         ])?)),
         n => Err(CliError::Usage(format!(
             "--lattice takes 4 numbers (2D: AX AY BX BY) or 9 (3D), not {n}"
+        ))),
+    }
+}
+
+/// The Klein bottle or a flat 3-manifold of `--space`, from the sides of its domain.
+fn manifold(name: &str, extent: &Extent) -> Result<Space, CliError> {
+    let sides = if name == "klein" { "L1 L2" } else { "L1 L2 L3" };
+    let Some(b) = &extent.box_lengths else {
+        return Err(CliError::Usage(format!(
+            "--lattice is for the torus only: --space {name} takes --box {sides}"
+        )));
+    };
+    match (name, &b[..]) {
+        ("klein", &[a, b]) => Ok(Space::Klein(FlatManifold::klein_bottle(a, b)?)),
+        (_, &[a, b, c]) if name != "klein" => {
+            Ok(Space::Manifold3(FlatManifold::platycosm(name, [a, b, c])?))
+        }
+        _ => Err(CliError::Usage(format!(
+            "--space {name} takes --box {sides}, not {} lengths",
+            b.len()
         ))),
     }
 }
@@ -233,16 +303,13 @@ struct Cost {
     peak_rss_kb: Option<u64>,
 }
 
-fn build<const D: usize, const N: usize>(
-    space: FlatTorus<D>,
+fn build<const D: usize, const N: usize, S: FlatSpace<D, N>>(
+    space: S,
     pts: &[[f64; D]],
-) -> Result<(PeriodicDelaunay<D, N>, Cost), orbitri::Error>
-where
-    FlatTorus<D>: Torus<D, N>,
-{
+) -> Result<(Triangulation<D, N, S>, Cost), orbitri::Error> {
     let bar = progress_bar(pts.len());
     let start = Instant::now();
-    let tri = PeriodicDelaunay::build_with(space, pts, BuildOptions::default(), |k| {
+    let tri = Triangulation::build_with(space, pts, BuildOptions::default(), |k| {
         if let Some(b) = &bar {
             b.set_position(k as u64);
         }
@@ -258,14 +325,11 @@ where
     Ok((tri, cost))
 }
 
-fn stats_line<const D: usize, const N: usize>(
-    tri: &PeriodicDelaunay<D, N>,
+fn stats_line<const D: usize, const N: usize, S: FlatSpace<D, N>>(
+    tri: &Triangulation<D, N, S>,
     input: usize,
     cost: &Cost,
-) -> String
-where
-    FlatTorus<D>: Torus<D, N>,
-{
+) -> String {
     format!(
         "input={input} vertices={} cells={} sheets={} duplicates={} wrapped={} dummies={} build_seconds={:.6} peak_rss_kb={}",
         tri.number_of_vertices(),
@@ -292,20 +356,14 @@ fn writer(path: &Option<PathBuf>) -> Result<Box<dyn Write>, CliError> {
 }
 
 fn triangulate(input: PathBuf, domain: Domain, out: Output) -> Result<(), CliError> {
-    match space(&domain)? {
-        Space::Two(s) => triangulate_in::<2, 3>(s, &input, out),
-        Space::Three(s) => triangulate_in::<3, 4>(s, &input, out),
-    }
+    with_space!(space(&domain)?, triangulate_in(&input, out))
 }
 
-fn triangulate_in<const D: usize, const N: usize>(
-    space: FlatTorus<D>,
+fn triangulate_in<const D: usize, const N: usize, S: SpaceFormat<D, N>>(
+    space: S,
     input: &Path,
     out: Output,
-) -> Result<(), CliError>
-where
-    FlatTorus<D>: Torus<D, N>,
-{
+) -> Result<(), CliError> {
     let pts: Vec<[f64; D]> = orbitri::io::read_points(input)?;
     let (tri, cost) = build(space, &pts)?;
     write_with(&out.output, |w| match out.format {
@@ -329,10 +387,7 @@ struct VoronoiArgs {
 }
 
 fn voronoi(input: PathBuf, domain: Domain, args: VoronoiArgs) -> Result<(), CliError> {
-    match space(&domain)? {
-        Space::Two(s) => voronoi_in::<2, 3>(s, &input, args),
-        Space::Three(s) => voronoi_in::<3, 4>(s, &input, args),
-    }
+    with_space!(space(&domain)?, voronoi_in(&input, args))
 }
 
 /// Writes a file (or standard output) with `f`, naming the path in errors.
@@ -347,15 +402,12 @@ fn write_with(
         .map_err(|source| CliError::Write { path: name, source })
 }
 
-fn voronoi_in<const D: usize, const N: usize>(
-    space: FlatTorus<D>,
+fn voronoi_in<const D: usize, const N: usize, S: SpaceFormat<D, N>>(
+    space: S,
     input: &Path,
     args: VoronoiArgs,
-) -> Result<(), CliError>
-where
-    FlatTorus<D>: Torus<D, N>,
-{
-    space.lattice().check_volume_representable()?;
+) -> Result<(), CliError> {
+    space.check_volume_representable()?;
     let pts: Vec<[f64; D]> = orbitri::io::read_points(input)?;
     let (tri, cost) = build(space, &pts)?;
     let by_extension = args.output.as_ref().and_then(|p| {
@@ -385,9 +437,8 @@ where
         VoronoiFormat::Vtu => orbitri::io::write_voronoi_vtu(w, &cells),
     })?;
     if args.neighbours.is_some() {
-        let pairs = orbitri::voronoi::neighbor_pairs(&cells);
         write_with(&args.neighbours, |w| {
-            orbitri::io::write_neighbors_csv(w, &pairs)
+            orbitri::io::write_neighbors_csv(w, &tri, &cells)
         })?;
     }
     if args.edges.is_some() {
@@ -398,7 +449,7 @@ where
         eprintln!(
             "{} voronoi_seconds={seconds:.6} volume_sum={total:?} domain_volume={:?} voronoi_peak_rss_kb={}",
             stats_line(&tri, pts.len(), &cost),
-            tri.space().lattice().volume(),
+            tri.space().volume(),
             rss::peak_kb().map_or("unknown".to_string(), |k| k.to_string())
         );
     }
@@ -406,14 +457,24 @@ where
 }
 
 fn draw(input: PathBuf, domain: Domain, output: PathBuf, opts: SvgOptions) -> Result<(), CliError> {
-    let Space::Two(space) = space(&domain)? else {
-        return Err(CliError::Usage(
-            "draw renders 2D tori: give --box LX LY or --lattice AX AY BX BY".into(),
-        ));
-    };
-    let pts: Vec<[f64; 2]> = orbitri::io::read_points(&input)?;
+    match space(&domain)? {
+        Space::Torus2(s) => draw_in(s, &input, output, opts),
+        Space::Klein(s) => draw_in(s, &input, output, opts),
+        _ => Err(CliError::Usage(
+            "draw renders 2D spaces: give --box LX LY or --lattice AX AY BX BY (or --space klein --box L1 L2)".into(),
+        )),
+    }
+}
+
+fn draw_in<S: Drawable>(
+    space: S,
+    input: &Path,
+    output: PathBuf,
+    opts: SvgOptions,
+) -> Result<(), CliError> {
+    let pts: Vec<[f64; 2]> = orbitri::io::read_points(input)?;
     opts.validate(pts.len()).map_err(option_error)?;
-    let (tri, _): (PeriodicDelaunay2, _) = build(space, &pts)?;
+    let (tri, _) = build(space, &pts)?;
     let mut svg = Vec::new();
     orbitri::io::write_svg(&mut svg, &tri, &opts).map_err(|e| {
         // writing to memory fails only on options out of range (a picture too high)
@@ -486,7 +547,7 @@ fn demo(n: usize, seed: u64) -> Result<(), CliError> {
         let _ = writeln!(out, "{s}");
     };
     let pts = uniform::<3>(n, seed);
-    let (tri, cost) = build::<3, 4>(FlatTorus3::cuboid([1.0; 3])?, &pts)?;
+    let (tri, cost) = build::<3, 4, _>(FlatTorus3::cuboid([1.0; 3])?, &pts)?;
     say(
         &mut out,
         format!("uniform random points in the unit cube (seed {seed}):"),
@@ -530,7 +591,7 @@ fn demo(n: usize, seed: u64) -> Result<(), CliError> {
             }
         }
     }
-    let (tri, cost) = build::<3, 4>(FlatTorus3::cuboid([0.6; 3])?, &fcc)?;
+    let (tri, cost) = build::<3, 4, _>(FlatTorus3::cuboid([0.6; 3])?, &fcc)?;
     say(
         &mut out,
         "FCC crystal, 864 points, all octahedral holes cospherical:".to_string(),
@@ -549,7 +610,7 @@ fn demo(n: usize, seed: u64) -> Result<(), CliError> {
     );
     // 2D: the same engine on the unit square, then a honeycomb (6 cocircular points around
     // every hexagon) in its hexagonal cell
-    let (tri, cost) = build::<2, 3>(FlatTorus2::cuboid([1.0; 2])?, &uniform::<2>(n, seed))?;
+    let (tri, cost) = build::<2, 3, _>(FlatTorus2::cuboid([1.0; 2])?, &uniform::<2>(n, seed))?;
     say(
         &mut out,
         format!("uniform random points in the unit square (seed {seed}):"),
@@ -567,7 +628,7 @@ fn demo(n: usize, seed: u64) -> Result<(), CliError> {
             }
         }
     }
-    let (tri, cost) = build::<2, 3>(hex, &honey)?;
+    let (tri, cost) = build::<2, 3, _>(hex, &honey)?;
     say(
         &mut out,
         "honeycomb, 800 points in a hexagonal cell, 6 cocircular points per hexagon:".to_string(),

@@ -1,8 +1,10 @@
-//! The Python extension `orbitri._orbitri`: the triangulation and its Voronoi cells for numpy
-//! arrays. The Python package (`python/orbitri`) parses boxes and documents the API; this
-//! module converts arrays (one copy of the input), releases the interpreter during
-//! construction, insertion and the Voronoi cells, and turns errors into `ValueError` with the
-//! library's message.
+//! The Python extension `orbitri._orbitri`: the triangulation of a flat torus, a Klein bottle
+//! or a flat 3-manifold and its Voronoi cells for numpy arrays. The Python package
+//! (`python/orbitri`) parses boxes and documents the API; this module converts arrays (one
+//! copy of the input), releases the interpreter during construction, insertion and the
+//! Voronoi cells, and turns errors into `ValueError` with the library's message. One class
+//! serves every space: group elements leave it as a coset (0 in a torus) and a lattice
+//! offset.
 //!
 //! Threads: a triangulation is shared through a read–write lock (readers together, `insert`,
 //! `locate` and `try_one_sheet` alone). No thread ever blocks on the lock while attached to
@@ -20,12 +22,11 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{mpsc, Arc, Mutex, RwLock, RwLockReadGuard, RwLockWriteGuard};
 use std::time::Duration;
 
-use numpy::ndarray::{Array1, Array2, Array3, ArrayView2};
-use numpy::{AllowTypeChange, IntoPyArray, PyArray1, PyArray2, PyArrayLike2};
-use orbitri::triangulation::Torus;
+use numpy::ndarray::{Array1, Array2, Array3, ArrayD, ArrayView2, IxDyn};
+use numpy::{AllowTypeChange, IntoPyArray, PyArray1, PyArray2, PyArrayLike1, PyArrayLike2};
 use orbitri::{
-    BuildOptions, CellMeasures, FlatTorus, PeriodicDelaunay, PeriodicDelaunay2, PeriodicDelaunay3,
-    VoronoiCell,
+    BuildOptions, CellMeasures, FlatManifold, FlatSpace, FlatTorus, Motion, OrbitSpace,
+    Triangulation as Tri_, VoronoiCell,
 };
 use pyo3::exceptions::{PyIndexError, PyOverflowError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
@@ -101,32 +102,96 @@ fn rows<const D: usize>(a: ArrayView2<'_, f64>) -> Vec<[f64; D]> {
         .collect()
 }
 
-fn matrix<const D: usize>(a: ArrayView2<'_, f64>) -> [[f64; D]; D] {
-    std::array::from_fn(|i| std::array::from_fn(|j| a[[i, j]]))
+/// The torus of the lattice whose rows are those of `a` (`D × D`).
+fn torus<const D: usize>(a: ArrayView2<'_, f64>) -> PyResult<FlatTorus<D>> {
+    FlatTorus::triclinic(std::array::from_fn(|i| std::array::from_fn(|j| a[[i, j]])))
+        .map_err(value_error)
 }
 
+/// A group element as the Python side sees it: a coset (0 in a torus) and a lattice offset.
+trait Element<const D: usize>: Copy {
+    fn coset(self) -> i32;
+    fn offset(self) -> [i8; D];
+}
+
+impl<const D: usize> Element<D> for [i8; D] {
+    fn coset(self) -> i32 {
+        0
+    }
+
+    fn offset(self) -> [i8; D] {
+        self
+    }
+}
+
+impl<const D: usize> Element<D> for Motion<D> {
+    fn coset(self) -> i32 {
+        i32::from(self.coset)
+    }
+
+    fn offset(self) -> [i8; D] {
+        self.offset
+    }
+}
+
+/// A space the bindings serve: a flat torus or a closed flat manifold.
+trait Served<const D: usize, const N: usize>:
+    FlatSpace<D, N, Elem: Element<D>> + Send + Sync + 'static
+{
+    /// Whether its elements have cosets other than 0 (Python's dicts then name them).
+    const COSETS: bool;
+    /// The rows of its lattice of translations.
+    fn lattice_rows(&self) -> [[f64; D]; D];
+}
+
+impl<const D: usize, const N: usize> Served<D, N> for FlatTorus<D>
+where
+    FlatTorus<D>: FlatSpace<D, N, Elem = [i8; D]>,
+{
+    const COSETS: bool = false;
+    fn lattice_rows(&self) -> [[f64; D]; D] {
+        self.lattice().vectors()
+    }
+}
+
+impl<const D: usize, const N: usize> Served<D, N> for FlatManifold<D>
+where
+    FlatManifold<D>: FlatSpace<D, N, Elem = Motion<D>>,
+{
+    const COSETS: bool = true;
+    fn lattice_rows(&self) -> [[f64; D]; D] {
+        self.translations().vectors()
+    }
+}
+
+/// The triangulation of any space the bindings serve.
 enum Tri {
-    Two(PeriodicDelaunay2),
-    Three(PeriodicDelaunay3),
+    Two(Tri_<2, 3, FlatTorus<2>>),
+    Three(Tri_<3, 4, FlatTorus<3>>),
+    Klein(Tri_<2, 3, FlatManifold<2>>),
+    Manifold3(Tri_<3, 4, FlatManifold<3>>),
 }
 
-/// Runs `$body` with `$t` bound to the triangulation of either dimension.
+/// Runs `$body` with `$t` bound to the triangulation of any space and dimension.
 macro_rules! with_tri {
     ($tri:expr, $t:ident => $body:expr) => {
         match $tri {
             Tri::Two($t) => $body,
             Tri::Three($t) => $body,
+            Tri::Klein($t) => $body,
+            Tri::Manifold3($t) => $body,
         }
     };
 }
 
-/// Runs `$body` with `$c` bound to the cells of either dimension and `$first` to the first
-/// occurrences.
+/// Runs `$body` with `$c` bound to the Voronoi cells of any space and dimension.
 macro_rules! with_cells {
-    ($cells:expr, $c:ident, $first:ident => $body:expr) => {
+    ($cells:expr, $c:ident => $body:expr) => {
         match $cells {
-            Cells::Two($c, $first) => $body,
-            Cells::Three($c, $first) => $body,
+            Cells::Two($c) => $body,
+            Cells::Three($c) => $body,
+            Cells::Klein($c) => $body,
+            Cells::Manifold3($c) => $body,
         }
     };
 }
@@ -142,8 +207,8 @@ fn array2<T: numpy::Element>(
         .into_pyarray(py)
 }
 
-/// A periodic Delaunay triangulation (use `orbitri.PeriodicDelaunay`), shareable between
-/// threads.
+/// The Delaunay triangulation of a flat torus or a closed flat manifold (use
+/// `orbitri.PeriodicDelaunay` or `orbitri.Triangulation`), shareable between threads.
 #[pyclass(module = "orbitri._orbitri", frozen)]
 struct Triangulation {
     /// Shared with a computation that may outlive an interrupted call (`voronoi`).
@@ -161,6 +226,14 @@ fn poisoned<T>(_: T) -> PyErr {
 }
 
 impl Triangulation {
+    fn of(tri: Tri, dim: usize) -> Self {
+        Triangulation {
+            tri: Arc::new(RwLock::new(tri)),
+            dim,
+            generation: AtomicU64::new(0),
+        }
+    }
+
     /// Shared access; waits (detached) while another thread modifies the triangulation.
     fn read(&self, py: Python<'_>) -> PyResult<RwLockReadGuard<'_, Tri>> {
         self.tri.read_py_attached(py).map_err(poisoned)
@@ -172,17 +245,13 @@ impl Triangulation {
     }
 }
 
-fn build<const D: usize, const N: usize>(
+fn build<const D: usize, const N: usize, S: Served<D, N>>(
     py: Python<'_>,
     points: Vec<[f64; D]>,
-    lattice: [[f64; D]; D],
-) -> PyResult<PeriodicDelaunay<D, N>>
-where
-    FlatTorus<D>: Torus<D, N>,
-{
+    space: S,
+) -> PyResult<Tri_<D, N, S>> {
     interruptible(py, points.len(), move |stop| {
-        let torus = FlatTorus::<D>::triclinic(lattice).map_err(value_error)?;
-        PeriodicDelaunay::build_with(torus, &points, BuildOptions::default(), |_| {
+        Tri_::build_with(space, &points, BuildOptions::default(), |_| {
             if stop.load(Ordering::Relaxed) {
                 ControlFlow::Break(())
             } else {
@@ -195,13 +264,10 @@ where
 
 /// Inserts row-major points of dimension `D`, all or nothing (the library checks every row
 /// first); their input ids.
-fn insert_all<const D: usize, const N: usize>(
-    t: &mut PeriodicDelaunay<D, N>,
+fn insert_all<const D: usize, const N: usize, S: Served<D, N>>(
+    t: &mut Tri_<D, N, S>,
     flat: &[f64],
-) -> orbitri::Result<Vec<i64>>
-where
-    FlatTorus<D>: Torus<D, N>,
-{
+) -> orbitri::Result<Vec<i64>> {
     let points: Vec<[f64; D]> = flat
         .chunks_exact(D)
         .map(|q| std::array::from_fn(|c| q[c]))
@@ -215,37 +281,132 @@ where
         .collect())
 }
 
-fn simplices<const D: usize, const N: usize>(
+/// Elements as Python sees them, for an array of shape `lead`: a torus's offsets
+/// (`lead × D`), a manifold's `(cosets, offsets)` (`lead` and `lead × D`).
+fn py_elements<const D: usize, const N: usize, S: Served<D, N>>(
     py: Python<'_>,
-    t: &PeriodicDelaunay<D, N>,
-) -> (Py<PyAny>, Py<PyAny>, Py<PyAny>)
-where
-    FlatTorus<D>: Torus<D, N>,
-{
+    lead: &[usize],
+    elements: impl IntoIterator<Item = S::Elem>,
+) -> Py<PyAny> {
+    let mut cosets = Vec::new();
+    let mut offsets = Vec::new();
+    for g in elements {
+        cosets.push(g.coset());
+        offsets.extend(g.offset().map(i32::from));
+    }
+    let mut shape = lead.to_vec();
+    shape.push(D);
+    let offsets = ArrayD::from_shape_vec(IxDyn(&shape), offsets)
+        .expect("shape matches")
+        .into_pyarray(py)
+        .into_any();
+    if !S::COSETS {
+        return offsets.unbind();
+    }
+    let cosets = ArrayD::from_shape_vec(IxDyn(lead), cosets)
+        .expect("shape matches")
+        .into_pyarray(py)
+        .into_any();
+    (cosets, offsets)
+        .into_pyobject(py)
+        .expect("a tuple")
+        .into_any()
+        .unbind()
+}
+
+/// (simplices, elements, neighbors) of every stored cell.
+fn simplices<const D: usize, const N: usize, S: Served<D, N>>(
+    py: Python<'_>,
+    t: &Tri_<D, N, S>,
+) -> (Py<PyAny>, Py<PyAny>, Py<PyAny>) {
     let (cells, nbrs) = t.cells_with_neighbors();
     let c = cells.len();
     let v: Vec<i64> = cells
         .iter()
         .flat_map(|x| x.vertices.map(i64::from))
         .collect();
-    let o: Vec<i32> = cells
-        .iter()
-        .flat_map(|x| x.offsets.into_iter().flatten().map(i32::from))
-        .collect();
     let n: Vec<i64> = nbrs.iter().flat_map(|x| x.map(i64::from)).collect();
     (
         array2(py, c, N, v).into_any().unbind(),
-        Array3::from_shape_vec((c, N, D), o)
-            .expect("shape matches")
-            .into_pyarray(py)
-            .into_any()
-            .unbind(),
+        py_elements::<D, N, S>(py, &[c, N], cells.iter().flat_map(|x| x.offsets)),
         array2(py, c, N, n).into_any().unbind(),
     )
 }
 
+/// (vertices, their elements, the point's element) of the cell containing `point`.
+fn locate<const D: usize, const N: usize, S: Served<D, N>>(
+    py: Python<'_>,
+    t: &mut Tri_<D, N, S>,
+    point: &[f64],
+) -> PyResult<(Py<PyAny>, Py<PyAny>, Py<PyAny>)> {
+    if point.len() != D {
+        return Err(PyValueError::new_err(format!(
+            "a point has {D} coordinates, not {}",
+            point.len()
+        )));
+    }
+    let (cell, o) = t
+        .locate(std::array::from_fn(|c| point[c]))
+        .map_err(value_error)?;
+    Ok((
+        cell.vertices
+            .map(i64::from)
+            .to_vec()
+            .into_pyarray(py)
+            .into_any()
+            .unbind(),
+        py_elements::<D, N, S>(py, &[N], cell.offsets),
+        py_elements::<D, N, S>(py, &[], [o]),
+    ))
+}
+
+/// (pairs E×2, elements, lengths E) of the Delaunay edges, each once.
+fn edges<const D: usize, const N: usize, S: Served<D, N>>(
+    py: Python<'_>,
+    t: &Tri_<D, N, S>,
+) -> (Py<PyAny>, Py<PyAny>, Py<PyAny>) {
+    let e = t.delaunay_edges();
+    let ij: Vec<i64> = e
+        .iter()
+        .flat_map(|x| [i64::from(x.i), i64::from(x.j)])
+        .collect();
+    let l: Vec<f64> = e.iter().map(|x| x.length).collect();
+    (
+        array2(py, e.len(), 2, ij).into_any().unbind(),
+        py_elements::<D, N, S>(py, &[e.len()], e.iter().map(|x| x.shift)),
+        l.into_pyarray(py).into_any().unbind(),
+    )
+}
+
+/// (ids, elements) of the Delaunay neighbours of input point `i`.
+fn vertex_neighbors<const D: usize, const N: usize, S: Served<D, N>>(
+    py: Python<'_>,
+    t: &Tri_<D, N, S>,
+    i: usize,
+) -> (Py<PyAny>, Py<PyAny>) {
+    let nb = t.vertex_neighbors(i);
+    let ids: Vec<i64> = nb.iter().map(|x| i64::from(x.0)).collect();
+    (
+        ids.into_pyarray(py).into_any().unbind(),
+        py_elements::<D, N, S>(py, &[nb.len()], nb.iter().map(|x| x.1)),
+    )
+}
+
+/// The Voronoi cells of a triangulation, stopping once `interrupt` says so.
+fn cells_of<const D: usize, const N: usize, S: Served<D, N>>(
+    t: &Tri_<D, N, S>,
+    interrupt: &(dyn Fn() -> bool + Sync),
+) -> PyResult<CellsOf<D, N, S>> {
+    Ok(CellsOf {
+        cells: t.voronoi_cells_until(interrupt).map_err(value_error)?,
+        first: t.first_occurrences(),
+        space: t.space().clone(),
+    })
+}
+
 #[pymethods]
 impl Triangulation {
+    /// The triangulation of a flat torus given by its lattice (rows).
     #[new]
     fn new(
         py: Python<'_>,
@@ -262,19 +423,38 @@ impl Triangulation {
             )));
         }
         let tri = match d {
-            2 => Tri::Two(build::<2, 3>(py, rows(p), matrix(l))?),
-            3 => Tri::Three(build::<3, 4>(py, rows(p), matrix(l))?),
+            2 => Tri::Two(build(py, rows(p), torus(l)?)?),
+            3 => Tri::Three(build(py, rows(p), torus(l)?)?),
             _ => {
                 return Err(PyValueError::new_err(format!(
                     "points must have 2 or 3 columns, not {d}"
                 )))
             }
         };
-        Ok(Triangulation {
-            tri: Arc::new(RwLock::new(tri)),
-            dim: d,
-            generation: AtomicU64::new(0),
-        })
+        Ok(Self::of(tri, d))
+    }
+
+    /// The triangulation of a closed flat manifold (a Klein bottle, a flat 3-manifold).
+    #[staticmethod]
+    fn in_manifold(
+        py: Python<'_>,
+        points: PyArrayLike2<'_, f64, AllowTypeChange>,
+        space: &Space,
+    ) -> PyResult<Self> {
+        let p = points.as_array();
+        let d = space.dimension();
+        if p.shape()[1] != d {
+            return Err(PyValueError::new_err(format!(
+                "the {} is {d}-dimensional: points must have {d} columns, not {}",
+                space.name(),
+                p.shape()[1]
+            )));
+        }
+        let tri = match &space.m {
+            Manifold::Two(m) => Tri::Klein(build(py, rows(p), m.clone())?),
+            Manifold::Three(m) => Tri::Manifold3(build(py, rows(p), m.clone())?),
+        };
+        Ok(Self::of(tri, d))
     }
 
     /// 2 or 3.
@@ -289,12 +469,12 @@ impl Triangulation {
         self.generation.load(Ordering::Acquire)
     }
 
-    /// The lattice vectors (rows).
+    /// The lattice vectors (rows) of the translations.
     #[getter]
     fn lattice<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let d = self.dim;
         Ok(with_tri!(&*self.read(py)?, t => {
-            let m = t.space().lattice().vectors();
-            array2(py, m.len(), m.len(), m.iter().flatten().copied().collect())
+            array2(py, d, d, t.space().lattice_rows().iter().flatten().copied().collect())
         }))
     }
 
@@ -311,7 +491,8 @@ impl Triangulation {
         }))
     }
 
-    /// (simplices, offsets, neighbors) of every stored cell.
+    /// (simplices, elements, neighbors) of every stored cell: a torus's elements are its
+    /// offsets, a manifold's (cosets, offsets).
     fn cells(&self, py: Python<'_>) -> PyResult<(Py<PyAny>, Py<PyAny>, Py<PyAny>)> {
         Ok(with_tri!(&*self.read(py)?, t => simplices(py, t)))
     }
@@ -326,7 +507,14 @@ impl Triangulation {
         Ok(with_tri!(&*self.read(py)?, t => t.is_one_sheeted()))
     }
 
-    /// Moves a triangulation still in a covering space to the 1-sheeted torus if its
+    /// Checks combinatorics and geometry exactly (without the interpreter).
+    fn is_valid(&self, py: Python<'_>) -> PyResult<bool> {
+        let guard = self.read(py)?;
+        let tri = &*guard;
+        Ok(py.detach(|| with_tri!(tri, t => t.is_valid().is_ok())))
+    }
+
+    /// Moves a triangulation still in a covering space to the 1-sheeted quotient if its
     /// projection is a simplicial complex; whether it is 1-sheeted.
     fn try_one_sheet(&self, py: Python<'_>) -> PyResult<bool> {
         let mut guard = self.write(py)?;
@@ -388,50 +576,21 @@ impl Triangulation {
         Ok(Array1::from(ids).into_pyarray(py))
     }
 
-    /// (vertices, offsets, point offset) of the cell containing a point.
+    /// (vertices, their elements, the point's element) of the cell containing a point.
     fn locate(
         &self,
         py: Python<'_>,
         point: Vec<f64>,
     ) -> PyResult<(Py<PyAny>, Py<PyAny>, Py<PyAny>)> {
-        with_tri!(&mut *self.write(py)?, t => {
-            let d = t.space().lattice().vectors().len();
-            if point.len() != d {
-                return Err(PyValueError::new_err(format!(
-                    "a point has {d} coordinates, not {}",
-                    point.len()
-                )));
-            }
-            let q = std::array::from_fn(|c| point[c]);
-            let (cell, o) = t.locate(q).map_err(value_error)?;
-            let n = cell.vertices.len();
-            Ok((
-                cell.vertices.map(i64::from).to_vec().into_pyarray(py).into_any().unbind(),
-                array2(py, n, d, cell.offsets.iter().flatten().map(|&x| i32::from(x)).collect())
-                    .into_any()
-                    .unbind(),
-                o.map(i32::from).to_vec().into_pyarray(py).into_any().unbind(),
-            ))
-        })
+        with_tri!(&mut *self.write(py)?, t => locate(py, t, &point))
     }
 
-    /// (pairs E×2, shifts E×D, lengths E) of the Delaunay edges, each once.
+    /// (pairs E×2, elements, lengths E) of the Delaunay edges, each once.
     fn edges(&self, py: Python<'_>) -> PyResult<(Py<PyAny>, Py<PyAny>, Py<PyAny>)> {
-        Ok(with_tri!(&*self.read(py)?, t => {
-            let e = t.delaunay_edges();
-            let d = t.space().lattice().vectors().len();
-            let ij: Vec<i64> = e.iter().flat_map(|x| [i64::from(x.i), i64::from(x.j)]).collect();
-            let s: Vec<i32> = e.iter().flat_map(|x| x.shift.map(i32::from)).collect();
-            let l: Vec<f64> = e.iter().map(|x| x.length).collect();
-            (
-                array2(py, e.len(), 2, ij).into_any().unbind(),
-                array2(py, e.len(), d, s).into_any().unbind(),
-                l.into_pyarray(py).into_any().unbind(),
-            )
-        }))
+        Ok(with_tri!(&*self.read(py)?, t => edges(py, t)))
     }
 
-    /// (ids, shifts) of the Delaunay neighbours of input point `i`: any integer (Python's
+    /// (ids, elements) of the Delaunay neighbours of input point `i`: any integer (Python's
     /// or numpy's, not a float or a string), `0 <= i < number_of_input_points`.
     fn vertex_neighbors(
         &self,
@@ -457,61 +616,110 @@ impl Triangulation {
             .ok()
             .filter(|&i| i < n)
             .ok_or_else(out_of_range)?;
-        with_tri!(&*guard, t => {
-            let nb = t.vertex_neighbors(i);
-            let d = t.space().lattice().vectors().len();
-            let ids: Vec<i64> = nb.iter().map(|x| i64::from(x.0)).collect();
-            let s: Vec<i32> = nb.iter().flat_map(|x| x.1.map(i32::from)).collect();
-            Ok((
-                ids.into_pyarray(py).into_any().unbind(),
-                array2(py, nb.len(), d, s).into_any().unbind(),
-            ))
-        })
+        Ok(with_tri!(&*guard, t => vertex_neighbors(py, t, i)))
     }
 
     /// The Voronoi cells of the points (computed without holding the interpreter; Ctrl-C
     /// stops them).
     fn voronoi(&self, py: Python<'_>) -> PyResult<Voronoi> {
         let vertices = with_tri!(&*self.read(py)?, t => {
-            t.space().lattice().check_volume_representable().map_err(value_error)?;
+            t.space().check_volume_representable().map_err(value_error)?;
             t.number_of_vertices()
         });
         let shared = Arc::clone(&self.tri);
         let cells = interruptible(py, vertices, move |stop| {
             let interrupt = || stop.load(Ordering::Relaxed);
             Ok(match &*shared.read().map_err(poisoned)? {
-                Tri::Two(t) => Cells::Two(
-                    t.voronoi_cells_until(&interrupt).map_err(value_error)?,
-                    t.first_occurrences(),
-                ),
-                Tri::Three(t) => Cells::Three(
-                    t.voronoi_cells_until(&interrupt).map_err(value_error)?,
-                    t.first_occurrences(),
-                ),
+                Tri::Two(t) => Cells::Two(cells_of(t, &interrupt)?),
+                Tri::Three(t) => Cells::Three(cells_of(t, &interrupt)?),
+                Tri::Klein(t) => Cells::Klein(cells_of(t, &interrupt)?),
+                Tri::Manifold3(t) => Cells::Manifold3(cells_of(t, &interrupt)?),
             })
         })?;
-        let per_point = with_cells!(&cells, c, first => PerPoint::of(c, first));
+        let per_point = with_cells!(&cells, c => PerPoint::of(c));
         Ok(Voronoi { cells, per_point })
     }
 }
 
-/// The cells of the distinct points (sorted by input id) and every input point's first
-/// occurrence.
-enum Cells {
-    Two(Vec<VoronoiCell<2>>, Vec<u32>),
-    Three(Vec<VoronoiCell<3>>, Vec<u32>),
+/// The Voronoi cells of the distinct points (sorted by input id), every input point's first
+/// occurrence, and the space (for the elements' inverses).
+struct CellsOf<const D: usize, const N: usize, S: Served<D, N>> {
+    cells: Vec<VoronoiCell<D, S::Elem>>,
+    first: Vec<u32>,
+    space: S,
 }
 
-/// The cell of every input point (a duplicate's is its first occurrence's).
-fn per_input<const D: usize>(cells: &[VoronoiCell<D>], first: &[u32]) -> Vec<usize> {
-    first
-        .iter()
-        .map(|f| {
-            cells
-                .binary_search_by_key(f, |c| c.point)
-                .expect("every first occurrence has a cell")
-        })
-        .collect()
+/// The cells of any space.
+enum Cells {
+    Two(CellsOf<2, 3, FlatTorus<2>>),
+    Three(CellsOf<3, 4, FlatTorus<3>>),
+    Klein(CellsOf<2, 3, FlatManifold<2>>),
+    Manifold3(CellsOf<3, 4, FlatManifold<3>>),
+}
+
+impl<const D: usize, const N: usize, S: Served<D, N>> CellsOf<D, N, S> {
+    /// The cell of every input point (a duplicate's is its first occurrence's).
+    fn per_input(&self) -> Vec<usize> {
+        self.first
+            .iter()
+            .map(|f| {
+                self.cells
+                    .binary_search_by_key(f, |c| c.point)
+                    .expect("every first occurrence has a cell")
+            })
+            .collect()
+    }
+
+    /// (pairs E×2, elements, areas E): each pair of neighbouring images once.
+    fn neighbors(&self, py: Python<'_>) -> (Py<PyAny>, Py<PyAny>, Py<PyAny>) {
+        let pairs = orbitri::voronoi::neighbor_pairs_by(&self.cells, |g| {
+            OrbitSpace::<N>::inverse(&self.space, g)
+        });
+        let ij: Vec<i64> = pairs
+            .iter()
+            .flat_map(|p| [i64::from(p.i), i64::from(p.j)])
+            .collect();
+        let a: Vec<f64> = pairs.iter().map(|p| p.area).collect();
+        (
+            array2(py, pairs.len(), 2, ij).into_any().unbind(),
+            py_elements::<D, N, S>(py, &[pairs.len()], pairs.iter().map(|p| p.shift)),
+            a.into_pyarray(py).into_any().unbind(),
+        )
+    }
+
+    /// Every distinct point's cell as a dict.
+    fn dicts<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
+        self.cells
+            .iter()
+            .map(|cell| {
+                let d = PyDict::new(py);
+                d.set_item("id", cell.point)?;
+                d.set_item("position", cell.position.to_vec())?;
+                d.set_item("volume", cell.volume)?;
+                d.set_item("centroid", cell.centroid.to_vec())?;
+                let v = cell.vertices.iter().flatten().copied().collect();
+                d.set_item("vertices", array2(py, cell.vertices.len(), D, v))?;
+                let faces = cell
+                    .faces
+                    .iter()
+                    .map(|f| {
+                        let fd = PyDict::new(py);
+                        fd.set_item("vertices", f.vertices.clone())?;
+                        fd.set_item("neighbor", f.neighbor)?;
+                        let offset = f.shift.offset().to_vec();
+                        match S::COSETS {
+                            true => fd.set_item("element", (f.shift.coset(), offset))?,
+                            false => fd.set_item("shift", offset)?,
+                        }
+                        fd.set_item("area", f.area)?;
+                        Ok(fd)
+                    })
+                    .collect::<PyResult<Vec<_>>>()?;
+                d.set_item("faces", faces)?;
+                Ok(d)
+            })
+            .collect()
+    }
 }
 
 /// Every input point's cell measures (a duplicate's are its first occurrence's).
@@ -525,10 +733,11 @@ struct PerPoint {
 }
 
 impl PerPoint {
-    fn of<const D: usize>(cells: &[VoronoiCell<D>], first: &[u32]) -> Self {
-        let m: Vec<CellMeasures<D>> = per_input(cells, first)
+    fn of<const D: usize, const N: usize, S: Served<D, N>>(c: &CellsOf<D, N, S>) -> Self {
+        let m: Vec<CellMeasures<D>> = c
+            .per_input()
             .into_iter()
-            .map(|k| CellMeasures::from(&cells[k]))
+            .map(|k| CellMeasures::from(&c.cells[k]))
             .collect();
         PerPoint {
             volumes: m.iter().map(|x| x.volume).collect(),
@@ -540,7 +749,8 @@ impl PerPoint {
     }
 }
 
-/// The periodic Voronoi cells of a triangulation (use `PeriodicDelaunay.voronoi()`).
+/// The Voronoi cells of a triangulation (use `PeriodicDelaunay.voronoi()` or
+/// `Triangulation.voronoi()`).
 #[pyclass(module = "orbitri._orbitri")]
 struct Voronoi {
     cells: Cells,
@@ -574,55 +784,198 @@ impl Voronoi {
         array2(py, p.volumes.len(), p.dimension, p.centroids.clone())
     }
 
-    /// (pairs E×2, shifts E×D, areas E): each pair of neighbouring images once.
+    /// (pairs E×2, elements, areas E): each pair of neighbouring images once; a torus's
+    /// elements are shifts (E×D), a manifold's (cosets E, offsets E×D).
     fn neighbors(&self, py: Python<'_>) -> (Py<PyAny>, Py<PyAny>, Py<PyAny>) {
-        with_cells!(&self.cells, c, _first => {
-            let pairs = orbitri::voronoi::neighbor_pairs(c);
-            let d = c.first().map_or(0, |x| x.centroid.len());
-            let ij: Vec<i64> = pairs.iter().flat_map(|p| [i64::from(p.i), i64::from(p.j)]).collect();
-            let s: Vec<i32> = pairs.iter().flat_map(|p| p.shift.map(i32::from)).collect();
-            let a: Vec<f64> = pairs.iter().map(|p| p.area).collect();
-            (
-                array2(py, pairs.len(), 2, ij).into_any().unbind(),
-                array2(py, pairs.len(), d, s).into_any().unbind(),
-                a.into_pyarray(py).into_any().unbind(),
-            )
-        })
+        with_cells!(&self.cells, c => c.neighbors(py))
     }
 
     /// Every distinct point's cell as a dict: id, position, volume, centroid, vertices
-    /// (K×D) and faces (dicts of vertices, neighbor, shift, area).
+    /// (K×D) and faces (dicts of vertices, neighbor, shift or element, area).
     fn cells<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
-        with_cells!(&self.cells, c, _first => c.iter().map(|cell| {
-            let d = PyDict::new(py);
-            d.set_item("id", cell.point)?;
-            d.set_item("position", cell.position.to_vec())?;
-            d.set_item("volume", cell.volume)?;
-            d.set_item("centroid", cell.centroid.to_vec())?;
-            let dim = cell.position.len();
-            d.set_item(
-                "vertices",
-                array2(py, cell.vertices.len(), dim, cell.vertices.iter().flatten().copied().collect()),
-            )?;
-            let faces = cell
-                .faces
-                .iter()
-                .map(|f| {
-                    let fd = PyDict::new(py);
-                    fd.set_item("vertices", f.vertices.clone())?;
-                    fd.set_item("neighbor", f.neighbor)?;
-                    fd.set_item("shift", f.shift.to_vec())?;
-                    fd.set_item("area", f.area)?;
-                    Ok(fd)
-                })
-                .collect::<PyResult<Vec<_>>>()?;
-            d.set_item("faces", faces)?;
-            Ok(d)
-        }).collect())
+        with_cells!(&self.cells, c => c.dicts(py))
     }
 
     fn __len__(&self) -> usize {
-        with_cells!(&self.cells, c, _first => c.len())
+        with_cells!(&self.cells, c => c.cells.len())
+    }
+}
+
+/// A closed flat manifold of dimension 2 or 3.
+#[derive(Clone)]
+enum Manifold {
+    Two(FlatManifold<2>),
+    Three(FlatManifold<3>),
+}
+
+/// Runs `$body` with `$m` bound to the manifold of either dimension.
+macro_rules! with_manifold {
+    ($space:expr, $m:ident => $body:expr) => {
+        match &$space.m {
+            Manifold::Two($m) => $body,
+            Manifold::Three($m) => $body,
+        }
+    };
+}
+
+/// An isometry `x ↦ A·x + t` as `(A, t)`.
+type Isometry<const D: usize> = ([[f64; D]; D], [f64; D]);
+
+/// Isometries as arrays: `A` (K×D×D), `t` (K×D).
+fn isometry_arrays<const D: usize>(py: Python<'_>, list: &[Isometry<D>]) -> (Py<PyAny>, Py<PyAny>) {
+    let a: Vec<f64> = list
+        .iter()
+        .flat_map(|x| x.0.into_iter().flatten())
+        .collect();
+    let t: Vec<f64> = list.iter().flat_map(|x| x.1).collect();
+    (
+        Array3::from_shape_vec((list.len(), D, D), a)
+            .expect("shape matches")
+            .into_pyarray(py)
+            .into_any()
+            .unbind(),
+        array2(py, list.len(), D, t).into_any().unbind(),
+    )
+}
+
+/// The isometries of the elements `(cosets[k], offsets[k])`; a `ValueError` names an element
+/// that does not exist.
+fn isometries<const D: usize>(
+    m: &FlatManifold<D>,
+    cosets: &[i64],
+    offsets: ArrayView2<'_, i64>,
+) -> PyResult<Vec<Isometry<D>>> {
+    if offsets.shape() != [cosets.len(), D] {
+        return Err(PyValueError::new_err(format!(
+            "{} cosets need offsets of shape ({}, {D}), not {:?}",
+            cosets.len(),
+            cosets.len(),
+            offsets.shape()
+        )));
+    }
+    let k = m.index() as i64;
+    cosets
+        .iter()
+        .zip(offsets.outer_iter())
+        .map(|(&c, o)| {
+            let coset = u8::try_from(c).ok().filter(|&c| i64::from(c) < k);
+            let coset = coset.ok_or_else(|| {
+                PyValueError::new_err(format!(
+                    "coset {c} does not exist: the {} has cosets 0 to {}",
+                    m.name(),
+                    k - 1
+                ))
+            })?;
+            let offset = o
+                .iter()
+                .map(|&x| i8::try_from(x))
+                .collect::<Result<Vec<i8>, _>>()
+                .map_err(|_| {
+                    PyValueError::new_err(format!(
+                        "offset {o} is out of range: its entries are -128 to 127"
+                    ))
+                })?;
+            let offset = std::array::from_fn(|i| offset[i]);
+            Ok(m.isometry(Motion { coset, offset }))
+        })
+        .collect()
+}
+
+/// A closed flat manifold (use `orbitri.FlatManifold` or `orbitri.KleinBottle`).
+#[pyclass(module = "orbitri._orbitri", frozen)]
+struct Space {
+    m: Manifold,
+}
+
+#[pymethods]
+impl Space {
+    /// The Klein bottle `"klein"` of sides `[a, b]`, or the platycosm `name` of sides
+    /// `[L1, L2, L3]`.
+    #[new]
+    fn new(name: &str, sides: Vec<f64>) -> PyResult<Self> {
+        let n = sides.len();
+        let m = match (name, &sides[..]) {
+            ("klein", &[a, b]) => FlatManifold::klein_bottle(a, b).map(Manifold::Two),
+            ("klein", _) => {
+                return Err(PyValueError::new_err(format!(
+                    "the Klein bottle takes 2 sides, [a, b], not {n}"
+                )))
+            }
+            (_, &[a, b, c]) => FlatManifold::platycosm(name, [a, b, c]).map(Manifold::Three),
+            // an unknown name: the library's error, which names the known ones
+            _ if !FlatManifold::PLATYCOSMS.contains(&name) => {
+                FlatManifold::platycosm(name, [1.0; 3]).map(Manifold::Three)
+            }
+            _ => {
+                return Err(PyValueError::new_err(format!(
+                    "the {name} takes 3 sides, [L1, L2, L3], not {n}"
+                )))
+            }
+        };
+        Ok(Space {
+            m: m.map_err(value_error)?,
+        })
+    }
+
+    #[getter]
+    fn name(&self) -> &'static str {
+        with_manifold!(self, m => m.name())
+    }
+
+    #[getter]
+    fn dimension(&self) -> usize {
+        match self.m {
+            Manifold::Two(_) => 2,
+            Manifold::Three(_) => 3,
+        }
+    }
+
+    /// The number of cosets of the translations.
+    #[getter]
+    fn index(&self) -> usize {
+        with_manifold!(self, m => m.index())
+    }
+
+    #[getter]
+    fn volume(&self) -> f64 {
+        with_manifold!(self, m => m.volume())
+    }
+
+    #[getter]
+    fn is_orientable(&self) -> bool {
+        with_manifold!(self, m => m.is_orientable())
+    }
+
+    #[getter]
+    fn systole(&self) -> f64 {
+        with_manifold!(self, m => m.systole())
+    }
+
+    /// The lattice vectors (rows) of the translations.
+    #[getter]
+    fn translations<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        let d = self.dimension();
+        with_manifold!(self, m => {
+            array2(py, d, d, m.translations().vectors().iter().flatten().copied().collect())
+        })
+    }
+
+    /// (A, t) of the generators: the translations, then the coset representatives 1….
+    #[getter]
+    fn generators(&self, py: Python<'_>) -> (Py<PyAny>, Py<PyAny>) {
+        with_manifold!(self, m => isometry_arrays(py, &m.generators()))
+    }
+
+    /// (A, t) of the elements `(cosets[k], offsets[k])`.
+    fn isometries(
+        &self,
+        py: Python<'_>,
+        cosets: PyArrayLike1<'_, i64, AllowTypeChange>,
+        offsets: PyArrayLike2<'_, i64, AllowTypeChange>,
+    ) -> PyResult<(Py<PyAny>, Py<PyAny>)> {
+        let c = cosets.as_array().to_vec();
+        let o = offsets.as_array();
+        with_manifold!(self, m => Ok(isometry_arrays(py, &isometries(m, &c, o)?)))
     }
 }
 
@@ -631,5 +984,7 @@ fn _orbitri(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_class::<Triangulation>()?;
     m.add_class::<Voronoi>()?;
+    m.add_class::<Space>()?;
+    m.add("PLATYCOSMS", FlatManifold::PLATYCOSMS.to_vec())?;
     Ok(())
 }

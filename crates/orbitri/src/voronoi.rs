@@ -219,7 +219,16 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     /// images once (`i < j`, or `i == j` with the shift greater than its inverse: for a
     /// torus, its first non-zero entry positive).
     pub fn voronoi_neighbors(&self) -> Vec<Neighbor<D, S::Elem>> {
-        pairs_by(&self.voronoi_cells(), |g| self.space().inverse(g))
+        self.voronoi_neighbors_of(&self.voronoi_cells())
+    }
+
+    /// The neighbour pairs of cells already computed (by [`Self::voronoi_cells`]), as
+    /// [`Self::voronoi_neighbors`] lists them.
+    pub fn voronoi_neighbors_of(
+        &self,
+        cells: &[VoronoiCell<D, S::Elem>],
+    ) -> Vec<Neighbor<D, S::Elem>> {
+        neighbor_pairs_by(cells, |g| self.space().inverse(g))
     }
 
     /// The shared duals, polling `interrupt` every 1024 cells.
@@ -541,12 +550,12 @@ fn order_polygon<const D: usize, E>(vertices: &mut Vec<[f64; D]>, faces: &mut [V
 /// The neighbour pairs of a torus's cells, each unordered pair of images once: `i < j`, or
 /// `i == j` with the shift's first non-zero entry positive.
 pub fn neighbor_pairs<const D: usize>(cells: &[VoronoiCell<D>]) -> Vec<Neighbor<D>> {
-    pairs_by(cells, |s| s.map(|x| -x))
+    neighbor_pairs_by(cells, |s| s.map(|x| -x))
 }
 
-/// The neighbour pairs, each unordered pair of images once: `i < j`, or `i == j` with the
-/// shift greater than its inverse.
-fn pairs_by<const D: usize, E: Copy + Ord>(
+/// The neighbour pairs of any space's cells, each unordered pair of images once: `i < j`, or
+/// `i == j` with the shift greater than its `inverse` (the space's).
+pub fn neighbor_pairs_by<const D: usize, E: Copy + Ord>(
     cells: &[VoronoiCell<D, E>],
     inverse: impl Fn(E) -> E,
 ) -> Vec<Neighbor<D, E>> {

@@ -1,14 +1,17 @@
 //! Readers (points from text or `.npy`) and writers (the `cells` format, JSON, SVG, the
-//! Voronoi tables, and VTK).
+//! Voronoi tables, and VTK) for every flat space ([`SpaceFormat`] says how a space writes
+//! its group elements).
 
+mod format;
 mod npy;
 mod svg;
 mod tessellation;
 mod text;
 mod write;
 
+pub use format::SpaceFormat;
 pub use npy::{encode_npy, encode_npy_matrix, parse_npy, read_npy};
-pub use svg::{write_svg, SvgOptions};
+pub use svg::{write_svg, Drawable, SvgOptions, Tiling};
 pub use tessellation::{
     point_table, write_delaunay_vtu, write_edges_csv, write_neighbors_csv, write_voronoi_json,
     write_voronoi_vtu, PointTable,

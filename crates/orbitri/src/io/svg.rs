@@ -1,12 +1,107 @@
-//! Pictures of a 2D periodic triangulation: the Delaunay edges, the Voronoi diagram and the
-//! points over `K × K` periodic copies of the domain, the original domain outlined, as SVG.
+//! Pictures of a 2D triangulation in a flat torus or a Klein bottle: the Delaunay edges, the
+//! Voronoi diagram and the points over `K × K` images of the domain, the original domain
+//! outlined, as SVG. In a Klein bottle every other column of images is a glide image
+//! (reflected), and a flag in each image shows its orientation.
 
 use std::fmt::Write as _;
 use std::io::Write;
 
 use crate::error::{Error, Result};
-use crate::space::Lattice;
-use crate::triangulation::PeriodicDelaunay2;
+use crate::space::{FlatManifold, FlatSpace, FlatTorus, Lattice, Motion};
+use crate::triangulation::Triangulation;
+
+/// How a picture tiles the plane with images of the domain (see [`Drawable`]).
+pub struct Tiling<'a> {
+    frame: Frame<'a>,
+    glide: bool,
+}
+
+/// The domain `{f·B : f ∈ [0,1)²}` and its translates by integer `f`, the tiles.
+#[derive(Clone, Copy)]
+enum Frame<'a> {
+    /// `B` a lattice (a torus: the tiles are the domain's translates).
+    Lattice(&'a Lattice<2>),
+    /// `B = diag(a, b)` (a Klein bottle's rectangle).
+    Rectangle([f64; 2]),
+}
+
+impl Frame<'_> {
+    fn cartesian(&self, f: [f64; 2]) -> [f64; 2] {
+        match self {
+            Frame::Lattice(l) => l.cartesian(&f),
+            Frame::Rectangle(s) => [f[0] * s[0], f[1] * s[1]],
+        }
+    }
+
+    fn fractional(&self, p: &[f64; 2]) -> [f64; 2] {
+        match self {
+            Frame::Lattice(l) => l.fractional(p),
+            Frame::Rectangle(s) => [p[0] / s[0], p[1] / s[1]],
+        }
+    }
+}
+
+/// A 2D space that [`write_svg`] draws: its domain tiles the plane in a grid of images under
+/// the group.
+pub trait Drawable: FlatSpace<2, 3> {
+    /// The tiling; an error for a space the pictures do not cover.
+    fn tiling(&self) -> Result<Tiling<'_>>;
+    /// The image `g·p` of a point, in user units.
+    fn apply(&self, g: Self::Elem, p: [f64; 2]) -> [f64; 2];
+}
+
+impl Drawable for FlatTorus<2> {
+    fn tiling(&self) -> Result<Tiling<'_>> {
+        Ok(Tiling {
+            frame: Frame::Lattice(self.lattice()),
+            glide: false,
+        })
+    }
+
+    fn apply(&self, g: [i8; 2], p: [f64; 2]) -> [f64; 2] {
+        let t = self.lattice().cartesian(&g.map(f64::from));
+        [p[0] + t[0], p[1] + t[1]]
+    }
+}
+
+/// A Klein bottle as [`FlatManifold::klein_bottle`] makes it: the tiles of the rectangle
+/// `a × b` are its images `(x, y) ↦ (x + i·a, (−1)^i·y + j·b)`. A manifold of index 1 is a
+/// torus.
+impl Drawable for FlatManifold<2> {
+    fn tiling(&self) -> Result<Tiling<'_>> {
+        let m = self.translations().vectors();
+        if self.index() == 1 {
+            return Ok(Tiling {
+                frame: Frame::Lattice(self.translations()),
+                glide: false,
+            });
+        }
+        let (a, b) = (m[0][0] / 2.0, m[1][1]);
+        let glide = self.isometry(Motion {
+            coset: 1,
+            offset: [0, 0],
+        });
+        if self.index() != 2
+            || m[0][1] != 0.0
+            || m[1][0] != 0.0
+            || glide != ([[1.0, 0.0], [0.0, -1.0]], [a, 0.0])
+        {
+            return Err(Error::InvalidBox(format!(
+                "{}: pictures show flat tori and Klein bottles gliding along the first axis",
+                self.name()
+            )));
+        }
+        Ok(Tiling {
+            frame: Frame::Rectangle([a, b]),
+            glide: true,
+        })
+    }
+
+    fn apply(&self, g: Motion<2>, p: [f64; 2]) -> [f64; 2] {
+        let (a, t) = self.isometry(g);
+        std::array::from_fn(|i| a[i][0] * p[0] + a[i][1] * p[1] + t[i])
+    }
+}
 
 /// What to draw.
 #[derive(Clone, Copy, Debug)]
@@ -86,19 +181,40 @@ impl Default for SvgOptions {
 }
 
 /// A Cartesian polyline or point with its extent in fractional coordinates, to be drawn at
-/// every lattice translation that brings it into the window.
+/// every tile's isometry that brings it into the window.
 struct Shape {
     pts: Vec<[f64; 2]>,
     fmin: [f64; 2],
     fmax: [f64; 2],
 }
 
-/// The page: the window in fractional coordinates `[lo, hi)²`, the lattice, and the map
-/// from Cartesian coordinates to pixels (y up).
+/// An isometry that maps the domain onto a tile: `(x, y) ↦ (x + t_x, ±y + t_y)`, the sign
+/// negative for a glide image.
+#[derive(Clone, Copy, PartialEq)]
+struct Place {
+    t: [f64; 2],
+    flip: bool,
+}
+
+impl Place {
+    fn apply(&self, p: [f64; 2]) -> [f64; 2] {
+        let y = if self.flip { -p[1] } else { p[1] };
+        [p[0] + self.t[0], y + self.t[1]]
+    }
+
+    fn is_identity(&self) -> bool {
+        self.t == [0.0, 0.0] && !self.flip
+    }
+}
+
+/// The page: the window in fractional coordinates `[lo, hi)²`, the frame of the tiles (and
+/// whether odd columns are glide images), and the map from Cartesian coordinates to pixels
+/// (y up).
 struct Page<'a> {
     lo: f64,
     hi: f64,
-    lattice: &'a Lattice<2>,
+    frame: Frame<'a>,
+    glide: bool,
     origin: [f64; 2],
     top: f64,
     scale: f64,
@@ -113,7 +229,7 @@ impl Page<'_> {
     }
 
     fn cart(&self, f: [f64; 2]) -> [f64; 2] {
-        self.lattice.cartesian(&f)
+        self.frame.cartesian(f)
     }
 
     /// A polyline or point, with its extent in fractional coordinates. A shape with a
@@ -125,7 +241,7 @@ impl Page<'_> {
             pts.clear();
         }
         for p in &pts {
-            let f = self.lattice.fractional(p);
+            let f = self.frame.fractional(p);
             for c in 0..2 {
                 fmin[c] = fmin[c].min(f[c]);
                 fmax[c] = fmax[c].max(f[c]);
@@ -134,28 +250,34 @@ impl Page<'_> {
         Shape { pts, fmin, fmax }
     }
 
-    /// Every translation `t` with `[fmin + t, fmax + t]` meeting the window.
-    fn translations(&self, s: &Shape) -> impl Iterator<Item = [f64; 2]> + '_ {
-        let range = |c: usize| {
-            let a = (self.lo - s.fmax[c]).ceil() as i64;
-            let b = (self.hi - s.fmin[c]).floor() as i64;
-            a..=b
+    /// Every tile's isometry that brings the shape into the window: the shifts `u` of the
+    /// fractional extent `[fmin, fmax]` (reflected, `[u − fmax, u − fmin]`, along the second
+    /// axis in a glide column) that meet the window.
+    fn places(&self, s: &Shape) -> impl Iterator<Item = Place> + '_ {
+        let (lo, hi, fmin, fmax) = (self.lo, self.hi, s.fmin, s.fmax);
+        let range = move |c: usize, flip: bool| {
+            let (a, b) = match flip {
+                false => ((lo - fmax[c]).ceil(), (hi - fmin[c]).floor()),
+                true => ((lo + fmin[c]).ceil(), (hi + fmax[c]).floor()),
+            };
+            a as i64..=b as i64
         };
-        let (rx, ry) = (range(0), range(1));
-        let lattice = self.lattice;
-        rx.flat_map(move |i| {
-            ry.clone()
-                .map(move |j| lattice.cartesian(&[i as f64, j as f64]))
+        range(0, false).flat_map(move |i| {
+            let flip = self.glide && i.rem_euclid(2) == 1;
+            range(1, flip).map(move |j| Place {
+                t: self.frame.cartesian([i as f64, j as f64]),
+                flip,
+            })
         })
     }
 
-    /// SVG path data of the shapes as polylines, at every translation into the window.
+    /// SVG path data of the shapes as polylines, at every tile's isometry into the window.
     fn path(&self, shapes: &[Shape]) -> String {
         let mut d = String::new();
         for s in shapes {
-            for t in self.translations(s) {
+            for t in self.places(s) {
                 for (k, p) in s.pts.iter().enumerate() {
-                    let (x, y) = self.px([p[0] + t[0], p[1] + t[1]]);
+                    let (x, y) = self.px(t.apply(*p));
                     let _ = write!(d, "{}{x:.2} {y:.2}", if k == 0 { "M" } else { "L" });
                 }
             }
@@ -171,38 +293,63 @@ fn a_shape_with_a_non_finite_coordinate_is_not_drawn() {
     let page = Page {
         lo: -1.0,
         hi: 2.0,
-        lattice: &lattice,
+        frame: Frame::Lattice(&lattice),
+        glide: false,
         origin: [0.0; 2],
         top: 0.0,
         scale: 100.0,
     };
     let good = page.shape(vec![[0.1, 0.2], [0.3, 0.4]]);
-    assert_eq!(page.translations(&good).count(), 9);
+    assert_eq!(page.places(&good).count(), 9);
     for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
         let s = page.shape(vec![[0.1, 0.2], [bad, 0.4], [0.5, 0.6]]);
-        assert_eq!(page.translations(&s).count(), 0);
+        assert_eq!(page.places(&s).count(), 0);
         let d = page.path(&[s, page.shape(vec![[0.1, 0.2], [0.3, 0.4]])]);
         assert!(!d.contains("NaN") && !d.contains("inf"), "{d}");
         assert_eq!(d, page.path(&[page.shape(vec![[0.1, 0.2], [0.3, 0.4]])]));
     }
 }
 
+#[cfg(test)]
+#[test]
+fn glide_columns_reflect_and_stay_in_their_tiles() {
+    let page = Page {
+        lo: -1.0,
+        hi: 2.0,
+        frame: Frame::Rectangle([2.0, 1.0]),
+        glide: true,
+        origin: [0.0; 2],
+        top: 0.0,
+        scale: 100.0,
+    };
+    let p = [0.5, 0.25];
+    let images: Vec<(Place, [f64; 2])> = page
+        .places(&page.shape(vec![p]))
+        .map(|t| (t, t.apply(p)))
+        .collect();
+    assert_eq!(images.len(), 9);
+    for (t, x) in images {
+        let tile = page.frame.fractional(&x).map(f64::floor);
+        // a point at a quarter of the domain's height: three quarters in a glide image
+        let within = page.frame.fractional(&x)[1] - tile[1];
+        assert_eq!(t.flip, tile[0] as i64 % 2 != 0, "{x:?}");
+        assert_eq!(within, if t.flip { 0.75 } else { 0.25 }, "{x:?}");
+        assert!((-1.0..2.0).contains(&tile[0]) && (-1.0..2.0).contains(&tile[1]));
+    }
+}
+
 /// The Delaunay edges (one per orbit) as segments from the library's edge list.
-fn delaunay_edges(page: &Page, tri: &PeriodicDelaunay2) -> Vec<Shape> {
+fn delaunay_edges<S: Drawable>(page: &Page, tri: &Triangulation<2, 3, S>) -> Vec<Shape> {
     let at = |i: u32| tri.point(tri.vertex_of_input(i as usize));
     tri.delaunay_edges()
         .into_iter()
-        .map(|e| {
-            let (a, b) = (at(e.i), at(e.j));
-            let t = page.lattice.cartesian(&e.shift.map(f64::from));
-            page.shape(vec![a, [b[0] + t[0], b[1] + t[1]]])
-        })
+        .map(|e| page.shape(vec![at(e.i), tri.space().apply(e.shift, at(e.j))]))
         .collect()
 }
 
 /// The Voronoi cells as closed polygons (the library's exact cells: every edge is drawn
 /// from both of its cells).
-fn voronoi_cells(page: &Page, tri: &PeriodicDelaunay2) -> Vec<Shape> {
+fn voronoi_cells<S: Drawable>(page: &Page, tri: &Triangulation<2, 3, S>) -> Vec<Shape> {
     tri.voronoi_cells()
         .into_iter()
         .filter(|c| !c.vertices.is_empty())
@@ -217,20 +364,22 @@ fn voronoi_cells(page: &Page, tri: &PeriodicDelaunay2) -> Vec<Shape> {
 /// Writes the picture as SVG. Options out of range (see [`SvgOptions::validate`]) give an
 /// error of kind `InvalidInput` whose inner error is the typed [`Error::InvalidOption`],
 /// before anything is written.
-pub fn write_svg(
+pub fn write_svg<S: Drawable>(
     w: &mut impl Write,
-    tri: &PeriodicDelaunay2,
+    tri: &Triangulation<2, 3, S>,
     opts: &SvgOptions,
 ) -> std::io::Result<()> {
     let out_of_range = |e: Error| std::io::Error::new(std::io::ErrorKind::InvalidInput, e);
     opts.validate(tri.number_of_vertices())
         .map_err(out_of_range)?;
+    let tiling = tri.space().tiling().map_err(out_of_range)?;
     let k = opts.copies.max(1) as f64;
     let lo = -f64::from((opts.copies.max(1) - 1) / 2);
     let mut page = Page {
         lo,
         hi: lo + k,
-        lattice: tri.space().lattice(),
+        frame: tiling.frame,
+        glide: tiling.glide,
         origin: [0.0; 2],
         top: 0.0,
         scale: 1.0,
@@ -304,9 +453,9 @@ pub fn write_svg(
         let mut pts = String::new();
         for p in tri.points() {
             let s = page.shape(vec![p]);
-            for t in page.translations(&s) {
-                let (x, y) = page.px([p[0] + t[0], p[1] + t[1]]);
-                let fill = if t == [0.0, 0.0] { "#111" } else { "#777" };
+            for t in page.places(&s) {
+                let (x, y) = page.px(t.apply(p));
+                let fill = if t.is_identity() { "#111" } else { "#777" };
                 let _ = writeln!(
                     pts,
                     r#"<circle cx="{x:.2}" cy="{y:.2}" r="{r:.2}" fill="{fill}"/>"#
@@ -348,5 +497,23 @@ pub fn write_svg(
         polygon(&domain),
         stroke * 3.0
     )?;
+    if page.glide {
+        writeln!(
+            w,
+            r##"<path id="glides" fill="none" stroke="#2b9348" stroke-width="{:.2}" d="{}"/>"##,
+            stroke * 2.0,
+            page.path(&flag(&page))
+        )?;
+    }
     writeln!(w, "</svg>")
+}
+
+/// The letter F in a corner of the domain: drawn in every tile, it reads reflected in the
+/// glide images.
+fn flag(page: &Page) -> [Shape; 2] {
+    let shape = |f: &[[f64; 2]]| page.shape(f.iter().map(|&x| page.cart(x)).collect());
+    [
+        shape(&[[0.08, 0.08], [0.08, 0.32], [0.2, 0.32]]),
+        shape(&[[0.08, 0.2], [0.16, 0.2]]),
+    ]
 }

@@ -6,11 +6,12 @@ use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::io::Write;
 
+use super::format::SpaceFormat;
 use super::npy::encode_npy_matrix;
-use super::write::json_f64;
-use crate::space::FlatTorus;
-use crate::triangulation::{PeriodicDelaunay, Torus};
-use crate::voronoi::{CellMeasures, Neighbor, VoronoiCell};
+use super::write::{json_f64, json_point};
+use crate::space::FlatSpace;
+use crate::triangulation::Triangulation;
+use crate::voronoi::{CellMeasures, VoronoiCell};
 use crate::Copies;
 
 const AXES: [&str; 3] = ["x", "y", "z"];
@@ -24,13 +25,10 @@ pub struct PointTable {
 }
 
 /// Builds the per-point table of a triangulation from its cells' measures (any order).
-pub fn point_table<const D: usize, const N: usize>(
-    tri: &PeriodicDelaunay<D, N>,
+pub fn point_table<const D: usize, const N: usize, S: FlatSpace<D, N>>(
+    tri: &Triangulation<D, N, S>,
     cells: &[CellMeasures<D>],
-) -> PointTable
-where
-    FlatTorus<D>: Torus<D, N>,
-{
+) -> PointTable {
     let by_point: HashMap<u32, &CellMeasures<D>> = cells.iter().map(|c| (c.point, c)).collect();
     let first = tri.first_occurrences();
     let mut columns: Vec<String> = ["id", "volume", "neighbours", "surface_area"]
@@ -91,74 +89,60 @@ impl PointTable {
     }
 }
 
-/// The neighbour pairs as CSV: `i,j,shift_x,shift_y[,shift_z],area`.
-pub fn write_neighbors_csv<const D: usize>(
+/// The Voronoi neighbour pairs of `cells` (as [`Triangulation::voronoi_cells`] gives them)
+/// as CSV, each pair of images once: `i,j,ELEMENT…,area`, the element's columns as
+/// [`SpaceFormat::element_columns`] names them (a torus's `shift_x,shift_y[,shift_z]`).
+pub fn write_neighbors_csv<const D: usize, const N: usize, S: SpaceFormat<D, N>>(
     w: &mut impl Write,
-    pairs: &[Neighbor<D>],
+    tri: &Triangulation<D, N, S>,
+    cells: &[VoronoiCell<D, S::Elem>],
 ) -> std::io::Result<()> {
-    let rows = pairs.iter().map(|p| (p.i, p.j, p.shift, p.area));
-    write_pairs_csv(w, "area", rows)
+    let rows = tri
+        .voronoi_neighbors_of(cells)
+        .into_iter()
+        .map(|p| (p.i, p.j, p.shift, p.area));
+    write_pairs_csv::<D, N, S>(w, "area", rows)
 }
 
-/// Rows `i,j,shift_x,shift_y[,shift_z],VALUE` under a header naming the value column.
-fn write_pairs_csv<const D: usize>(
+/// Rows `i,j,ELEMENT…,VALUE` under a header naming the element's and the value's columns.
+fn write_pairs_csv<const D: usize, const N: usize, S: SpaceFormat<D, N>>(
     w: &mut impl Write,
     value: &str,
-    rows: impl Iterator<Item = (u32, u32, [i8; D], f64)>,
+    rows: impl Iterator<Item = (u32, u32, S::Elem, f64)>,
 ) -> std::io::Result<()> {
-    let shifts: Vec<String> = (0..D).map(|k| format!("shift_{}", AXES[k])).collect();
-    writeln!(w, "i,j,{},{value}", shifts.join(","))?;
-    for (i, j, shift, x) in rows {
-        let s: Vec<String> = shift.iter().map(|x| x.to_string()).collect();
+    writeln!(w, "i,j,{},{value}", S::element_columns().join(","))?;
+    for (i, j, g, x) in rows {
+        let s: Vec<String> = S::element_integers(g).map(|x| x.to_string()).collect();
         writeln!(w, "{i},{j},{},{x:?}", s.join(","))?;
     }
     Ok(())
 }
 
-/// The Delaunay edges as CSV: `i,j,shift_x,shift_y[,shift_z],length`, `j`'s image at
-/// `points[j] + shift·M`.
-pub fn write_edges_csv<const D: usize, const N: usize>(
+/// The Delaunay edges as CSV: `i,j,ELEMENT…,length`, `j`'s image at `g·points[j]` (in a
+/// torus `points[j] + shift·M`).
+pub fn write_edges_csv<const D: usize, const N: usize, S: SpaceFormat<D, N>>(
     w: &mut impl Write,
-    tri: &PeriodicDelaunay<D, N>,
-) -> std::io::Result<()>
-where
-    FlatTorus<D>: Torus<D, N>,
-{
+    tri: &Triangulation<D, N, S>,
+) -> std::io::Result<()> {
     let rows = tri
         .delaunay_edges()
         .into_iter()
         .map(|e| (e.i, e.j, e.shift, e.length));
-    write_pairs_csv(w, "length", rows)
+    write_pairs_csv::<D, N, S>(w, "length", rows)
 }
 
-fn json_point(p: &[f64]) -> String {
-    let v: Vec<String> = p.iter().map(|&x| json_f64(x)).collect();
-    format!("[{}]", v.join(","))
-}
-
-/// JSON: `{"dimension", "lattice", "cells": [{"id", "position", "volume", "centroid",
-/// "vertices", "faces": [{"vertices", "neighbor", "shift", "area"}]}], "duplicate_of"}`,
-/// cells in order of their first occurrence; `duplicate_of[i]` is the first occurrence's id.
-pub fn write_voronoi_json<const D: usize, const N: usize>(
+/// JSON: `{"dimension"`, the space ([`SpaceFormat::json_space`]), `"cells": [{"id",
+/// "position", "volume", "centroid", "vertices", "faces": [{"vertices", "neighbor", ELEMENT,
+/// "area"}]}], "duplicate_of"}`, cells in order of their first occurrence;
+/// `duplicate_of[i]` is the first occurrence's id. A face's element is a torus's `"shift"`,
+/// a manifold's `"element"` `[A, t]`: the neighbour's image across the face.
+pub fn write_voronoi_json<const D: usize, const N: usize, S: SpaceFormat<D, N>>(
     w: &mut impl Write,
-    tri: &PeriodicDelaunay<D, N>,
-    cells: &[VoronoiCell<D>],
-) -> std::io::Result<()>
-where
-    FlatTorus<D>: Torus<D, N>,
-{
-    let lattice: Vec<String> = tri
-        .space()
-        .lattice()
-        .vectors()
-        .iter()
-        .map(|r| json_point(r))
-        .collect();
-    write!(
-        w,
-        "{{\"dimension\":{D},\"lattice\":[{}],\"cells\":[",
-        lattice.join(",")
-    )?;
+    tri: &Triangulation<D, N, S>,
+    cells: &[VoronoiCell<D, S::Elem>],
+) -> std::io::Result<()> {
+    let space = tri.space();
+    write!(w, "{{\"dimension\":{D},{},\"cells\":[", space.json_space())?;
     for (k, c) in cells.iter().enumerate() {
         let vertices: Vec<String> = c.vertices.iter().map(|v| json_point(v)).collect();
         let faces: Vec<String> = c
@@ -166,13 +150,13 @@ where
             .iter()
             .map(|f| {
                 format!(
-                    "{{\"vertices\":{:?},\"neighbor\":{},\"shift\":{:?},\"area\":{}}}",
-                    f.vertices,
+                    "{{\"vertices\":{},\"neighbor\":{},\"{}\":{},\"area\":{}}}",
+                    format!("{:?}", f.vertices).replace(' ', ""),
                     f.neighbor,
-                    f.shift,
+                    S::FACE_ELEMENT,
+                    space.json_element(f.shift),
                     json_f64(f.area)
                 )
-                .replace(' ', "")
             })
             .collect();
         write!(
@@ -278,9 +262,9 @@ impl Vtu {
 /// The Voronoi cells as a `.vtu`: each cell whole around its point (cells that cross the
 /// domain boundary are not cut), polyhedra in 3D, polygons in 2D, with the input id and the
 /// volume as cell data and the id as point data.
-pub fn write_voronoi_vtu<const D: usize>(
+pub fn write_voronoi_vtu<const D: usize, E>(
     w: &mut impl Write,
-    cells: &[VoronoiCell<D>],
+    cells: &[VoronoiCell<D, E>],
 ) -> std::io::Result<()> {
     let mut v = Vtu::default();
     let (mut ids, mut pid, mut vol) = (Vec::new(), Vec::new(), Vec::new());
@@ -311,18 +295,16 @@ pub fn write_voronoi_vtu<const D: usize>(
     v.write(w)
 }
 
-/// The triangulation as a `.vtu`: one copy of each cell of the torus, drawn whole at its
-/// stored offsets (cells crossing the boundary stick out of the domain), vertex positions
-/// `p + o·M` shared between cells, and the input id of each vertex as point data.
-pub fn write_delaunay_vtu<const D: usize, const N: usize>(
+/// The triangulation as a `.vtu`: one copy of each cell of the space, drawn whole at its
+/// stored elements (cells crossing the boundary stick out of the domain), vertex positions
+/// `g·p` (in a torus `p + o·M`) shared between cells, and the input id of each vertex as
+/// point data.
+pub fn write_delaunay_vtu<const D: usize, const N: usize, S: FlatSpace<D, N>>(
     w: &mut impl Write,
-    tri: &PeriodicDelaunay<D, N>,
-) -> std::io::Result<()>
-where
-    FlatTorus<D>: Torus<D, N>,
-{
+    tri: &Triangulation<D, N, S>,
+) -> std::io::Result<()> {
     let mut v = Vtu::default();
-    let mut index: HashMap<(u32, [i8; D]), u64> = HashMap::new();
+    let mut index: HashMap<(u32, S::Elem), u64> = HashMap::new();
     let mut pid = Vec::new();
     for c in tri.cells(Copies::Unique) {
         for k in 0..N {

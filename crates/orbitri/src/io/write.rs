@@ -2,20 +2,18 @@
 
 use std::io::Write;
 
-use crate::space::FlatTorus;
-use crate::triangulation::{PeriodicDelaunay, Torus};
+use super::format::SpaceFormat;
+use crate::triangulation::Triangulation;
 
 /// The `cells` format: `SHEETS V C`, then per stored cell its `D + 1` input ids and their
-/// offsets (`D` integers each, lattice units), positively oriented (counter-clockwise in
-/// 2D). `V` counts distinct points, `C` the cell lines that follow (in a covering space:
-/// every stored copy).
-pub fn write_cells<const D: usize, const N: usize>(
+/// elements' integers ([`SpaceFormat::element_integers`]: a torus's offsets, `D` integers
+/// each in lattice units; a manifold's coset and offset, `1 + D` each), positively oriented
+/// (counter-clockwise in 2D). `V` counts distinct points, `C` the cell lines that follow (in
+/// a covering space: every stored copy).
+pub fn write_cells<const D: usize, const N: usize, S: SpaceFormat<D, N>>(
     w: &mut impl Write,
-    tri: &PeriodicDelaunay<D, N>,
-) -> std::io::Result<()>
-where
-    FlatTorus<D>: Torus<D, N>,
-{
+    tri: &Triangulation<D, N, S>,
+) -> std::io::Result<()> {
     writeln!(
         w,
         "{} {} {}",
@@ -33,8 +31,8 @@ where
             line.extend_from_slice(num.format(v).as_bytes());
             line.push(b' ');
         }
-        for x in c.offsets.iter().flatten() {
-            line.extend_from_slice(num.format(*x).as_bytes());
+        for x in c.offsets.into_iter().flat_map(S::element_integers) {
+            line.extend_from_slice(num.format(x).as_bytes());
             line.push(b' ');
         }
         line.pop();
@@ -54,6 +52,12 @@ pub(super) fn json_f64(x: f64) -> String {
     }
 }
 
+/// A vector as a JSON array of numbers.
+pub(super) fn json_point(p: &[f64]) -> String {
+    let v: Vec<String> = p.iter().map(|&x| json_f64(x)).collect();
+    format!("[{}]", v.join(","))
+}
+
 #[cfg(test)]
 #[test]
 fn json_f64_writes_null_for_non_finite_numbers() {
@@ -65,29 +69,24 @@ fn json_f64_writes_null_for_non_finite_numbers() {
     }
 }
 
-/// JSON: `{"dimension", "sheets", "lattice", "points" (wrapped, input order),
-/// "first_occurrence", "cells", "offsets"}`, written as it is produced.
-pub fn write_json<const D: usize, const N: usize>(
+/// JSON: `{"dimension", "sheets"`, the space ([`SpaceFormat::json_space`]: a torus's
+/// `"lattice"`, a manifold's `"space"` and `"group"`), `"points"` (wrapped, input order),
+/// `"first_occurrence", "cells"` and the cells' elements (a torus's `"offsets"`, a manifold's
+/// `"elements"`, one `[A, t]` per vertex)`}`, written as it is produced.
+pub fn write_json<const D: usize, const N: usize, S: SpaceFormat<D, N>>(
     w: &mut impl Write,
-    tri: &PeriodicDelaunay<D, N>,
-) -> std::io::Result<()>
-where
-    FlatTorus<D>: Torus<D, N>,
-{
-    let row = |r: &[f64; D]| {
-        let v: Vec<String> = r.iter().map(|&x| json_f64(x)).collect();
-        format!("[{}]", v.join(","))
-    };
+    tri: &Triangulation<D, N, S>,
+) -> std::io::Result<()> {
+    let space = tri.space();
     write!(
         w,
-        "{{\"dimension\":{D},\"sheets\":{},\"lattice\":[",
-        tri.sheets()
+        "{{\"dimension\":{D},\"sheets\":{},{},\"points\":[",
+        tri.sheets(),
+        space.json_space()
     )?;
-    write_list(w, tri.space().lattice().vectors().iter().map(row))?;
-    write!(w, "],\"points\":[")?;
     write_list(
         w,
-        (0..tri.number_of_input_points()).map(|i| row(&tri.point(tri.vertex_of_input(i)))),
+        (0..tri.number_of_input_points()).map(|i| json_point(&tri.point(tri.vertex_of_input(i)))),
     )?;
     write!(w, "],\"first_occurrence\":[")?;
     write_list(w, tri.first_occurrences().iter().map(|x| x.to_string()))?;
@@ -97,11 +96,13 @@ where
         tri.stored_cells()
             .map(|c| format!("{:?}", c.vertices).replace(' ', "")),
     )?;
-    write!(w, "],\"offsets\":[")?;
+    write!(w, "],\"{}\":[", S::CELL_ELEMENTS)?;
     write_list(
         w,
-        tri.stored_cells()
-            .map(|c| format!("{:?}", c.offsets).replace(' ', "")),
+        tri.stored_cells().map(|c| {
+            let elements: Vec<String> = c.offsets.iter().map(|&g| space.json_element(g)).collect();
+            format!("[{}]", elements.join(","))
+        }),
     )?;
     writeln!(w, "]}}")
 }
