@@ -336,7 +336,7 @@ fn simplices<const D: usize, const N: usize, S: Served<D, N>>(
 /// (vertices, their elements, the point's element) of the cell containing `point`.
 fn locate<const D: usize, const N: usize, S: Served<D, N>>(
     py: Python<'_>,
-    t: &mut Tri_<D, N, S>,
+    t: &Tri_<D, N, S>,
     point: &[f64],
 ) -> PyResult<(Py<PyAny>, Py<PyAny>, Py<PyAny>)> {
     if point.len() != D {
@@ -582,7 +582,8 @@ impl Triangulation {
         py: Python<'_>,
         point: Vec<f64>,
     ) -> PyResult<(Py<PyAny>, Py<PyAny>, Py<PyAny>)> {
-        with_tri!(&mut *self.write(py)?, t => locate(py, t, &point))
+        // the walk only reads: concurrent readers may locate in parallel
+        with_tri!(&*self.read(py)?, t => locate(py, t, &point))
     }
 
     /// (pairs E×2, elements, lengths E) of the Delaunay edges, each once.
