@@ -193,12 +193,11 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             let was = &old.cells[c as usize];
             let mut cell = Cell::new(was.v, was.off);
             cell.n = was.n.map(|d| orbit[d as usize]);
-            let reversed = self.space.normalize(&mut cell.off, level);
-            cell.v =
-                std::array::from_fn(|i| self.vertex_id(old_vpoint[was.v[i] as usize], cell.off[i]));
-            if reversed {
-                cell.swap_slots(0, 1);
-            }
+            // in the new level's canonical form, then renumbered for its sheets
+            self.canonicalize(&mut cell);
+            cell.v = std::array::from_fn(|i| {
+                self.vertex_id(old_vpoint[cell.v[i] as usize], cell.off[i])
+            });
             self.add_cell(cell);
         }
         for k in 0..reps.len() as u32 {

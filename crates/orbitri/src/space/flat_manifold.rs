@@ -17,7 +17,7 @@
 
 use super::flat_torus::{perturbed_by, UnperturbedInSphere, L};
 use super::lattice::{Ladder, Level};
-use super::{least_translate, FlatSpace, FlatTorus, Lattice, OrbitSpace};
+use super::{least_frame, least_translate, FlatSpace, FlatTorus, Lattice, OrbitSpace};
 use crate::error::{Error, Result};
 use crate::predicates::Sign;
 
@@ -124,7 +124,6 @@ fn overflow(x: i32) -> ! {
 fn one_point_need<const D: usize>(t: &Lattice<D>, k: usize, axis: usize) -> f64 {
     let m = &t.rows.m;
     let sq = |r: &[f64; D]| r.iter().map(|x| x * x).sum::<f64>();
-    let rho_t = 0.5 * m.iter().map(sq).sum::<f64>().sqrt();
     let others: Vec<&[f64; D]> = (0..D).filter(|&i| i != axis).map(|i| &m[i]).collect();
     // the measure of the other vectors' cell: a length in 2D, an area in 3D
     let base = if D == 2 {
@@ -138,19 +137,10 @@ fn one_point_need<const D: usize>(t: &Lattice<D>, k: usize, axis: usize) -> f64 
         ];
         (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt()
     };
-    let volume = match D {
-        2 => (m[0][0] * m[1][1] - m[0][1] * m[1][0]).abs(),
-        _ => {
-            let d = |i: usize, j: usize| m[i][j];
-            (d(0, 0) * (d(1, 1) * d(2, 2) - d(1, 2) * d(2, 1))
-                - d(0, 1) * (d(1, 0) * d(2, 2) - d(1, 2) * d(2, 0))
-                + d(0, 2) * (d(1, 0) * d(2, 1) - d(1, 1) * d(2, 0)))
-            .abs()
-        }
-    };
-    let w = volume / base / k as f64;
+    let w = t.volume_in() / base / k as f64;
     let rho_layer = (w * w + 0.25 * others.iter().map(|r| sq(r)).sum::<f64>()).sqrt();
-    4.0 * rho_t.min(rho_layer) * (1.0 + 1e-9)
+    // T's own bound, 4·½√(Σ|b_i|²) with the same margin
+    t.one_point_need().min(4.0 * rho_layer * (1.0 + 1e-9))
 }
 
 fn not_a_group(why: String) -> Error {
@@ -662,18 +652,8 @@ where
         if off.iter().all(|&g| g == one) {
             return false;
         }
-        // the quotient: among h = g_i⁻¹, the one giving the least sorted list of elements
-        // (unique: G is torsion-free, so no h ≠ 1 permutes a finite set of elements)
-        let mut best: Option<(Motion<D>, [Motion<D>; N])> = None;
-        for i in 0..N {
-            let h = self.inverse_elem(off[i]);
-            let mut moved = off.map(|g| self.compose_elems(h, g));
-            moved.sort_unstable();
-            if best.as_ref().is_none_or(|b| moved < b.1) {
-                best = Some((h, moved));
-            }
-        }
-        let (h, _) = best.expect("a cell has vertices");
+        // the quotient: the canonical frame of the cell's elements
+        let h = least_frame::<Self, N, ()>(self, &off.map(|g| ((), g)));
         if h == one {
             return false;
         }
@@ -684,43 +664,14 @@ where
     }
 
     fn dummy_points(&self) -> Vec<P<D>> {
-        // a jittered grid over T's domain, fine enough for δ(G) (see `Lattice::dummy_grid`),
-        // with a multiple of k columns along the slab axis; the columns in the slab are kept
-        // (their images fill the rest of T's domain)
-        let m = self
-            .fine
-            .lattice()
-            .rows
-            .m
-            .map(|r| r.map(|x| x * self.q as f64));
-        let k = self.cosets.len();
-        let mut n = [0usize; D];
-        for i in 0..D {
-            let len = m[i].iter().map(|x| x * x).sum::<f64>().sqrt();
-            let x = len * (D as f64).sqrt() * 2.0 * 1.04 / self.systole;
-            n[i] = (x.floor() as usize + 1).max(2);
-        }
-        n[self.slab_axis] = n[self.slab_axis].div_ceil(k) * k;
-        let keep = n[self.slab_axis] / k;
-        let total: usize = n.iter().product();
-        let mut rng = crate::sort::SplitMix::new(0x0b17_2a11);
-        let mut out = Vec::new();
-        for idx in 0..total {
-            let mut rem = idx;
-            let mut f = [0.0; D];
-            let mut inside = true;
-            for i in 0..D {
-                let g = rem % n[i];
-                rem /= n[i];
-                let jitter = 0.02 * (2.0 * rng.unit() - 1.0);
-                f[i] = (g as f64 + 0.5 + jitter) / n[i] as f64 * self.q as f64;
-                inside &= i != self.slab_axis || g < keep;
-            }
-            if inside {
-                out.push(self.fine.lattice().cartesian_in(&f));
-            }
-        }
-        out
+        // a grid over T's domain fine enough for δ(G), of which the slab is kept (its images
+        // fill the rest); T's internal frame is the manifold's divided by q (exactly)
+        let q = self.q as f64;
+        self.translations
+            .dummy_grid_for(self.systole / q, self.slab_axis, self.cosets.len())
+            .into_iter()
+            .map(|p| p.map(|x| x * q))
+            .collect()
     }
 
     fn sheets(&self, level: usize) -> usize {

@@ -245,6 +245,11 @@ impl<const D: usize> Lattice<D> {
         self.rows.m.map(|r| self.to_user(r))
     }
 
+    /// Volume (area in 2D) of the domain in the internal frame.
+    pub(crate) fn volume_in(&self) -> f64 {
+        self.volume
+    }
+
     /// Length of the shortest non-zero lattice vector (δ).
     pub fn systole(&self) -> f64 {
         self.measure_to_user(self.systole, 1)
@@ -420,7 +425,7 @@ impl<const D: usize> Lattice<D> {
     /// Twice the largest empty-ball diameter one point's orbit can leave, bounded by
     /// `√(Σ|b_i|²)` (covering radius ≤ ½√(Σ|b_i|²)), with a relative margin: a covering whose
     /// systole exceeds it triangulates every non-empty point set.
-    fn one_point_need(&self) -> f64 {
+    pub(crate) fn one_point_need(&self) -> f64 {
         2.0 * self.rows.m.iter().map(|r| dot(r, r)).sum::<f64>().sqrt() * (1.0 + 1e-9)
     }
 
@@ -514,25 +519,39 @@ impl<const D: usize> Lattice<D> {
     /// diameter at most `S`, the jitter (2% of a grid step per axis) adds at most `0.04·S`,
     /// and `k_i` is chosen so that `1.04·S < δ/2`.
     pub fn dummy_grid(&self) -> Vec<[f64; D]> {
+        self.dummy_grid_for(self.systole, 0, 1)
+    }
+
+    /// [`Self::dummy_grid`] for a space of systole `systole` (internal frame) whose domain
+    /// is the part of this lattice's below `1/parts` along `axis`: the counts along `axis`
+    /// are a multiple of `parts`, and only the grid points in that slab are kept (the
+    /// space's group maps them onto the others).
+    pub(crate) fn dummy_grid_for(&self, systole: f64, axis: usize, parts: usize) -> Vec<[f64; D]> {
         let mut k = [0usize; D];
         for i in 0..D {
-            let x = norm(&self.rows.m[i]) * (D as f64).sqrt() * 2.0 * 1.04 / self.systole;
+            let x = norm(&self.rows.m[i]) * (D as f64).sqrt() * 2.0 * 1.04 / systole;
             k[i] = (x.floor() as usize + 1).max(2);
         }
+        k[axis] = k[axis].div_ceil(parts) * parts;
+        let keep = k[axis] / parts;
         let total: usize = k.iter().product();
         let mut rng = crate::sort::SplitMix::new(0x0b17_2a11);
-        let mut out = Vec::with_capacity(total);
+        let mut out = Vec::with_capacity(total / parts);
         for idx in 0..total {
             let mut rem = idx;
             let mut f = [0.0; D];
+            let mut inside = true;
             for i in 0..D {
                 let g = rem % k[i];
                 rem /= k[i];
                 let jitter = 0.02 * (2.0 * rng.unit() - 1.0);
                 f[i] = (g as f64 + 0.5 + jitter) / k[i] as f64;
+                inside &= i != axis || g < keep;
             }
             // inside the domain by construction (f ∈ (0, 1)): no wrap, no trip to user units
-            out.push(self.cartesian_in(&f));
+            if inside {
+                out.push(self.cartesian_in(&f));
+            }
         }
         out
     }

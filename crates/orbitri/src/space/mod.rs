@@ -179,27 +179,43 @@ pub trait FlatSpace<const D: usize, const N: usize>:
     fn check_volume_representable(&self) -> crate::error::Result<()>;
 }
 
-/// [`FlatSpace::canonical_face`] for any group: among the translations by `g_i⁻¹` (which
-/// bring vertex `i` to the identity), the one giving the least sorted pairs. It is unique for
-/// a torsion-free group: no element other than the identity permutes a finite set of
-/// elements.
+/// The canonical frame of a few (tag, element) pairs (at most 4: a cell or one of its faces):
+/// among the translations by `g_i⁻¹`, which bring item `i` to the identity, the one that
+/// gives the least sorted list of pairs. It is unique for a torsion-free group: no element
+/// other than the identity permutes a finite set of elements.
+pub(crate) fn least_frame<S: OrbitSpace<N>, const N: usize, T: Ord + Copy>(
+    space: &S,
+    items: &[(T, S::Elem)],
+) -> S::Elem {
+    const MAX: usize = 4;
+    let len = items.len();
+    assert!((1..=MAX).contains(&len), "a frame of 1 to {MAX} items");
+    let mut best = [items[0]; MAX];
+    let mut moved = [items[0]; MAX];
+    let mut frame = None;
+    for &(_, g) in items {
+        let h = space.inverse(g);
+        for (m, &(t, x)) in moved.iter_mut().zip(items) {
+            *m = (t, space.compose(h, x));
+        }
+        moved[..len].sort_unstable();
+        if frame.is_none() || moved[..len] < best[..len] {
+            best = moved;
+            frame = Some(h);
+        }
+    }
+    frame.expect("at least one item")
+}
+
+/// [`FlatSpace::canonical_face`] for any group: the pairs moved into their
+/// [`least_frame`], sorted.
 pub(crate) fn least_translate<S: OrbitSpace<N>, const N: usize>(
     space: &S,
     pairs: &mut [(u32, S::Elem)],
 ) {
-    let mut best: Option<Vec<(u32, S::Elem)>> = None;
-    for i in 0..pairs.len() {
-        let h = space.inverse(pairs[i].1);
-        let mut moved: Vec<(u32, S::Elem)> = pairs
-            .iter()
-            .map(|&(v, g)| (v, space.compose(h, g)))
-            .collect();
-        moved.sort_unstable();
-        if best.as_ref().is_none_or(|b| moved < *b) {
-            best = Some(moved);
-        }
+    let h = least_frame::<S, N, u32>(space, pairs);
+    for p in pairs.iter_mut() {
+        p.1 = space.compose(h, p.1);
     }
-    if let Some(b) = best {
-        pairs.copy_from_slice(&b);
-    }
+    pairs.sort_unstable();
 }
