@@ -702,15 +702,9 @@ where
         let lat = self.fine.lattice();
         let r = radius * (1.0 + 1e-9) + 1e-12 * self.systole;
         let q = self.q as f64;
-        // a move of length r changes T-fractional coordinate c by at most r·|column c of M⁻¹|
-        let span: [f64; D] = std::array::from_fn(|c| {
-            let col: f64 = (0..D)
-                .map(|k| {
-                    lat.fractional_in(&std::array::from_fn(|j| (j == k) as i32 as f64))[c].powi(2)
-                })
-                .sum();
-            r * col.sqrt() / q
-        });
+        // how far a move of length r reaches in T's fractional coordinates (T's vectors are
+        // q times the fine lattice's)
+        let span = lat.fractional_reach(r).map(|x| x / q);
         for (i, p) in pts.iter().enumerate() {
             for coset in 0..self.cosets.len() as u8 {
                 let base = self.position(

@@ -287,16 +287,7 @@ impl<const D: usize> FlatTorus<D> {
         let fz = self.lattice.fractional_in(&zc);
         let r = radius * (1.0 + 1e-9) + 1e-12 * self.lattice.systole_in();
         // a Cartesian move of length r changes fractional coordinate c by at most r·|column c of M⁻¹|
-        let span: [f64; D] = std::array::from_fn(|c| {
-            let col: f64 = (0..D)
-                .map(|k| {
-                    self.lattice
-                        .fractional_in(&std::array::from_fn(|j| if j == k { 1.0 } else { 0.0 }))[c]
-                        .powi(2)
-                })
-                .sum();
-            r * col.sqrt()
-        });
+        let span = self.lattice.fractional_reach(r);
         let lo: [i32; D] = std::array::from_fn(|c| (fz[c] - span[c]).floor() as i32 - 1);
         let side: [i32; D] = std::array::from_fn(|c| (fz[c] + span[c]).ceil() as i32 - lo[c] + 1);
         let total: usize = side.iter().map(|&s| s as usize).product();

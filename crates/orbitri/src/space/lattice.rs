@@ -245,6 +245,20 @@ impl<const D: usize> Lattice<D> {
         self.rows.m.map(|r| self.to_user(r))
     }
 
+    /// How much a Cartesian move of length `r` (internal frame) can change each fractional
+    /// coordinate: `r` times the length of the matching column of `M⁻¹`.
+    pub(crate) fn fractional_reach(&self, r: f64) -> [f64; D] {
+        std::array::from_fn(|c| {
+            let col: f64 = (0..D)
+                .map(|k| {
+                    let unit: [f64; D] = std::array::from_fn(|j| if j == k { 1.0 } else { 0.0 });
+                    self.fractional_in(&unit)[c].powi(2)
+                })
+                .sum();
+            r * col.sqrt()
+        })
+    }
+
     /// Volume (area in 2D) of the domain in the internal frame.
     pub(crate) fn volume_in(&self) -> f64 {
         self.volume
