@@ -1,5 +1,6 @@
-"""Triangulations of closed flat manifolds from Python: the Klein bottle and two flat
-3-manifolds (the Hantzsche–Wendt didicosm, orientable; the first amphicosm, not), checked by
+"""Triangulations of closed flat manifolds from Python: the Klein bottle and flat
+3-manifolds (the Hantzsche–Wendt didicosm, orientable; the first amphicosm, not; the
+hexagonal screws), checked by
 lifting every simplex with numpy, by Voronoi volumes, and against the command line."""
 
 import json
@@ -104,11 +105,27 @@ def test_the_group_of_a_space():
     for name in orbitri.FlatManifold.PLATYCOSMS:
         m = orbitri.FlatManifold(name, BOX3)
         a, t = m.generators
-        assert len(a) == 3 + m.index - 1 and m.volume == 1.25
+        across = 3**0.5 / 2 if name in ("tricosm", "hexacosm") else 1.0
+        assert len(a) == 3 + m.index - 1 and m.volume == pytest.approx(1.25 * across, rel=1e-15)
         assert m.is_orientable == (np.linalg.det(a) > 0).all()
         np.testing.assert_array_equal(t[:3], m.translations)
     assert "didicosm" in repr(orbitri.FlatManifold("didicosm", BOX3))
     assert repr(k) == "KleinBottle(1.0, 0.5)"
+
+
+@pytest.mark.parametrize("name, index", [("tricosm", 3), ("hexacosm", 6)])
+def test_the_hexagonal_screws(name, index):
+    space = orbitri.FlatManifold(name, BOX3)
+    assert space.index == index and space.is_orientable
+    # the 60° rhombus of side 1 times 1.25
+    assert space.volume == pytest.approx(1.25 * 3**0.5 / 2, rel=1e-15)
+    a, _ = space.generators
+    # the screw turns by a third or a sixth: its trace in the plane is 2·cos(2π/index)
+    np.testing.assert_allclose(np.trace(a[3][:2, :2]), 2 * np.cos(2 * np.pi / index), atol=1e-15)
+    for n in (3, 400):
+        tri = orbitri.Triangulation(_random(BOX3, n, n), space=space)
+        assert tri.is_valid()
+        assert abs(tri.voronoi().volumes.sum() - space.volume) <= 1e-12 * space.volume
 
 
 def test_bad_spaces_boxes_and_elements_are_value_errors():
@@ -117,9 +134,8 @@ def test_bad_spaces_boxes_and_elements_are_value_errors():
     with pytest.raises(ValueError, match="unknown flat 3-manifold \"mobius\""):
         orbitri.FlatManifold("mobius", [1.0, 1.0])
     for name in ("tricosm", "hexacosm"):
-        if name not in orbitri.FlatManifold.PLATYCOSMS:
-            with pytest.raises(ValueError, match=f"{name}.*one of torocosm"):
-                orbitri.FlatManifold(name, BOX3)
+        with pytest.raises(ValueError, match=f"the {name} turns a hexagonal cross-section of side L1: L1 = L2"):
+            orbitri.FlatManifold(name, [1.0, 2.0, 1.0])
     with pytest.raises(ValueError, match=r"the Klein bottle takes 2 sides, \[a, b\], not 3"):
         orbitri.FlatManifold("klein", BOX3)
     with pytest.raises(ValueError, match=r"the dicosm takes 3 sides, \[L1, L2, L3\], not 2"):

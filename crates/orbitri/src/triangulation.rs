@@ -447,7 +447,9 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
 
     /// The wrapped position of vertex `v` (a point index).
     pub fn point(&self, v: u32) -> [f64; D] {
-        self.space().to_user(self.engine.points()[v as usize])
+        let space = self.space();
+        let p = self.engine.points()[v as usize];
+        space.to_user(space.lifted_position((p, space.identity())))
     }
 
     /// The position of input point `i`'s image under the group element `offset` (in a

@@ -410,10 +410,12 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         for f in faces.iter_mut() {
             f.area = space.measure_to_user(f.area, D as i32 - 1);
         }
-        let around = |x: &[f64; D]| space.to_user(std::array::from_fn(|c| position[c] + x[c]));
+        // the stored point may be in another frame (lattice coordinates): its position
+        let here = space.lifted_position((position, space.identity()));
+        let around = |x: &[f64; D]| space.to_user(std::array::from_fn(|c| here[c] + x[c]));
         VoronoiCell {
             point: self.input_of_vertex(p),
-            position: space.to_user(position),
+            position: space.to_user(here),
             vertices: vertices.iter().map(around).collect(),
             faces,
             volume: space.measure_to_user(volume, D as i32),

@@ -42,6 +42,14 @@ where
         // a covering (a few points): valid as a triangulation of the covering space
         return;
     }
+    let turns = match m.name() {
+        "tricosm" => 3,
+        "hexacosm" => 6,
+        _ => 0,
+    };
+    if turns > 0 {
+        return verify_hexagonal(tri, turns, what);
+    }
     let manifold = Manifold {
         generators: m
             .generators()
@@ -50,6 +58,7 @@ where
             .collect(),
         volume: m.volume(),
         euler: 0,
+        metric: [1.0; D],
     };
     let cells: Vec<([u32; N], [Isometry<D>; N])> = tri
         .cells(Copies::Unique)
@@ -62,6 +71,118 @@ where
         })
         .collect();
     check(&manifold, &tri.points(), &cells).unwrap_or_else(|e| panic!("{what}: {e}"));
+}
+
+/// The checker in coordinates where a hexagonal screw space's group is rational: with
+/// `u` the stored coordinates in the lattice `(a1, a2, a3)/q` (`q` = turns, `a2` at 60°
+/// from `a1`), `y = (u1 + u2/2, u2/2, u3)` has the metric `diag(1, 3, (q·L3/L1)²)` up to
+/// scale, the translations `q·(1, 0, 0)`, `q·(½, ½, 0)`, `q·(0, 0, 1)`, and the sixth of a
+/// turn `(y1, y2) ↦ (y1/2 − 3y2/2, y1/2 + y2/2)`. Coset `c` is the screw to the power `c`
+/// (the presentation in `platycosms.rs`); the test box has `L1 = 1`.
+#[allow(clippy::type_complexity)]
+fn hexagonal_frame<const D: usize, const N: usize>(
+    tri: &Triangulation<D, N, FlatManifold<D>>,
+    turns: usize,
+) -> (
+    Manifold<D>,
+    Vec<[f64; D]>,
+    Vec<([u32; N], [Isometry<D>; N])>,
+)
+where
+    FlatManifold<D>: FlatSpace<D, N, Elem = Motion<D>>,
+{
+    assert_eq!((D, BOX[0], BOX[1]), (3, 1.0, 1.0));
+    let q = turns as f64;
+    let y = |u: &[f64; D]| -> [f64; D] {
+        std::array::from_fn(|i| match i {
+            0 => u[0] + u[1] / 2.0,
+            1 => u[1] / 2.0,
+            _ => u[2],
+        })
+    };
+    let mul = |a: &[[f64; D]; D], b: &[[f64; D]; D]| -> [[f64; D]; D] {
+        std::array::from_fn(|i| std::array::from_fn(|j| (0..D).map(|k| a[i][k] * b[k][j]).sum()))
+    };
+    let mut sixth = Isometry::<D>::identity().a;
+    (sixth[0][0], sixth[0][1], sixth[1][0], sixth[1][1]) = (0.5, -1.5, 0.5, 0.5);
+    let step = if turns == 3 {
+        mul(&sixth, &sixth)
+    } else {
+        sixth
+    };
+    let mut powers = vec![Isometry::<D>::identity().a];
+    for c in 1..turns {
+        powers.push(mul(&powers[c - 1], &step));
+    }
+    let unit = |i: usize| -> [f64; D] { std::array::from_fn(|j| if i == j { q } else { 0.0 }) };
+    let mut generators: Vec<Isometry<D>> =
+        (0..D).map(|i| Isometry::translation(y(&unit(i)))).collect();
+    generators.push(Isometry {
+        a: step,
+        t: std::array::from_fn(|i| if i == 2 { 1.0 } else { 0.0 }),
+    });
+    let manifold = Manifold {
+        generators,
+        volume: q * q / 2.0,
+        euler: 0,
+        metric: std::array::from_fn(|i| [1.0, 3.0, q * q * BOX[2] * BOX[2]][i]),
+    };
+    let element = |g: Motion<D>| {
+        let t: [f64; D] = std::array::from_fn(|i| {
+            let shift = if i == 2 { g.coset as f64 } else { 0.0 };
+            shift + q * g.offset[i] as f64
+        });
+        Isometry {
+            a: powers[g.coset as usize],
+            t: y(&t),
+        }
+    };
+    let cells: Vec<([u32; N], [Isometry<D>; N])> = tri
+        .cells(Copies::Unique)
+        .iter()
+        .map(|c| {
+            (
+                c.vertices.map(|i| tri.vertex_of_input(i as usize)),
+                c.offsets.map(element),
+            )
+        })
+        .collect();
+    let stored: Vec<[f64; D]> = tri.engine().points().iter().map(y).collect();
+    (manifold, stored, cells)
+}
+
+fn verify_hexagonal<const D: usize, const N: usize>(
+    tri: &Triangulation<D, N, FlatManifold<D>>,
+    turns: usize,
+    what: &str,
+) where
+    FlatManifold<D>: FlatSpace<D, N, Elem = Motion<D>>,
+{
+    let (manifold, stored, cells) = hexagonal_frame(tri, turns);
+    check(&manifold, &stored, &cells).unwrap_or_else(|e| panic!("{what} (lattice frame): {e}"));
+}
+
+/// The check in the hexagonal frame is not vacuous: a cell with one vertex moved to
+/// another image, or the same triangulation in the wrong metric, fails it.
+#[test]
+fn the_hexagonal_check_rejects_wrong_cells() {
+    for (name, turns) in [("tricosm", 3), ("hexacosm", 6)] {
+        let m = FlatManifold::platycosm(name, BOX).unwrap();
+        let tri = Triangulation::build(m, &random(400, 21, BOX)).unwrap();
+        assert!(tri.is_one_sheeted());
+        let (manifold, stored, cells) = hexagonal_frame::<3, 4>(&tri, turns);
+        check(&manifold, &stored, &cells).unwrap();
+        let mut moved = cells.clone();
+        moved[5].1[2].t[2] += turns as f64;
+        assert!(check(&manifold, &stored, &moved).is_err(), "{name}");
+        // a hexagonal lattice is no square one: the same cells are not Delaunay for the
+        // metric diag(1, 1, ·) (the sixth of a turn is not even its isometry)
+        let square = Manifold {
+            metric: [1.0, 1.0, manifold.metric[2]],
+            ..manifold
+        };
+        assert!(check(&square, &stored, &cells).is_err(), "{name}");
+    }
 }
 
 /// Dyadic boxes, so that every group element is exact in doubles (the checker asks it).
@@ -94,7 +215,9 @@ fn the_groups_are_what_their_names_say() {
     let expect = [
         ("torocosm", 1, true),
         ("dicosm", 2, true),
+        ("tricosm", 3, true),
         ("tetracosm", 4, true),
+        ("hexacosm", 6, true),
         ("didicosm", 4, true),
         ("first-amphicosm", 2, false),
         ("second-amphicosm", 2, false),
@@ -108,20 +231,23 @@ fn the_groups_are_what_their_names_say() {
             (index, orientable),
             "{name}"
         );
-        assert_eq!(m.volume(), 1.25, "{name}");
+        // a square or a 60° rhombus of side 1 across, 1.25 along the third axis
+        let across = if matches!(name, "tricosm" | "hexacosm") {
+            3f64.sqrt() / 2.0
+        } else {
+            1.0
+        };
+        assert!((m.volume() - 1.25 * across).abs() < 1e-15, "{name}");
         assert!(m.systole() > 0.0, "{name}: torsion-free");
     }
     let klein = FlatManifold::klein_bottle(1.0, 1.0).unwrap();
     assert_eq!((klein.index(), klein.is_orientable()), (2, false));
     assert!(FlatManifold::platycosm("tetracosm", [1.0, 2.0, 1.0]).is_err());
     assert!(FlatManifold::platycosm("tricosm-of-mars", BOX).is_err());
-    let e = FlatManifold::platycosm("hexacosm", BOX)
+    let e = FlatManifold::platycosm("hexacosm", [1.0, 1.5, 1.0])
         .unwrap_err()
         .to_string();
-    assert!(
-        e.contains("sixth of a turn") && e.contains("didicosm"),
-        "{e}"
-    );
+    assert!(e.contains("L1 = L2"), "{e}");
     assert!(FlatManifold::platycosm("dicosm", [1.0, 0.0, 1.0]).is_err());
 }
 
@@ -264,8 +390,20 @@ fn crystals_and_orders_give_one_triangulation() {
         .map(|i| [i % 8, i / 8 % 8, i / 64].map(|x| (x as f64 + 0.5) * 0.125))
         .collect();
     for name in FlatManifold::PLATYCOSMS {
-        for pts in [grid.clone(), random(1500, 9, BOX)] {
-            let m = FlatManifold::platycosm(name, BOX).unwrap();
+        let m = FlatManifold::platycosm(name, BOX).unwrap();
+        // the hexagonal spaces get the same grid in their own lattice's coordinates: a
+        // hexagonal crystal
+        let crystal = if matches!(name, "tricosm" | "hexacosm") {
+            let t = m.translations().clone();
+            let k = m.index() as f64;
+            grid.iter()
+                .map(|g| t.cartesian(&[g[0], g[1], g[2] / 1.25 / k]))
+                .collect()
+        } else {
+            grid.clone()
+        };
+        for pts in [crystal, random(1500, 9, BOX)] {
+            let m = m.clone();
             // from the dummy points, as large inputs are built (the covering path is
             // exercised by the smaller sets above)
             let opts = BuildOptions {
@@ -289,7 +427,10 @@ fn crystals_and_orders_give_one_triangulation() {
                 "{name}: the input order changed the cells"
             );
             let volume: f64 = a.voronoi_cells().iter().map(|c| c.volume).sum();
-            assert!((volume - 1.25).abs() < 1e-12, "{name}: {volume}");
+            assert!(
+                (volume - a.space().volume()).abs() < 1e-12,
+                "{name}: {volume}"
+            );
         }
     }
 }
@@ -299,12 +440,23 @@ fn crystals_and_orders_give_one_triangulation() {
 /// images exact).
 #[test]
 fn images_under_the_group_are_duplicates() {
-    let pts: Vec<[f64; 3]> = random(60, 13, BOX)
+    let dyadic: Vec<[f64; 3]> = random(60, 13, BOX)
         .iter()
         .map(|p| p.map(|x| (x * 1024.0).floor() / 1024.0))
         .collect();
     for name in FlatManifold::PLATYCOSMS {
         let m = FlatManifold::platycosm(name, BOX).unwrap();
+        // in the hexagonal spaces, points of dyadic lattice coordinates: their images,
+        // computed in doubles, round back to the same lattice coordinates
+        let pts: Vec<[f64; 3]> = if matches!(name, "tricosm" | "hexacosm") {
+            let t = m.translations().clone();
+            dyadic
+                .iter()
+                .map(|p| t.cartesian(&[p[0], p[1], p[2] / 8.0]))
+                .collect()
+        } else {
+            dyadic.clone()
+        };
         let mut all = pts.clone();
         for (a, t) in m.generators() {
             all.extend(pts.iter().map(|p| {

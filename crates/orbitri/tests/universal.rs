@@ -293,6 +293,7 @@ fn klein() -> Manifold<2> {
         ],
         volume: 1.0,
         euler: 0,
+        metric: [1.0; 2],
     }
 }
 
@@ -304,10 +305,11 @@ fn int(x: &BigRational) -> i64 {
 #[test]
 fn klein_bottle_group() {
     let m = klein();
-    let g = Group::new(&m.generators).unwrap();
+    let one = [1.0, 1.0].map(|x| BigRational::from_float(x).unwrap());
+    let g = Group::new(&m.generators, &one).unwrap();
     assert_eq!(g.cosets.len(), 2);
     assert_eq!(g.covolume, BigRational::from_float(1.0).unwrap());
-    let exact = |i: &Isometry<2>| Element::from_isometry(i).unwrap();
+    let exact = |i: &Isometry<2>| Element::from_isometry(i, &one).unwrap();
     let gamma = exact(&m.generators[0]);
     let tau = exact(&m.generators[1]);
     assert_eq!(

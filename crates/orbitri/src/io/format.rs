@@ -62,11 +62,20 @@ where
     }
 }
 
-/// An isometry `x ↦ A·x + t` as `[A, t]`; `A` is a signed permutation, written in integers.
+/// An isometry `x ↦ A·x + t` as `[A, t]`; `A`'s integer entries (all of a signed
+/// permutation's) are written as integers, the others (`±√3/2` in a hexagonal turn) as
+/// doubles.
 fn json_isometry<const D: usize>((a, t): ([[f64; D]; D], [f64; D])) -> String {
+    let entry = |x: f64| {
+        if x == x.trunc() {
+            format!("{}", x as i64)
+        } else {
+            format!("{x:?}")
+        }
+    };
     let rows: Vec<String> = a
         .iter()
-        .map(|r| format!("{:?}", r.map(|x| x as i64)).replace(' ', ""))
+        .map(|r| format!("[{}]", r.map(entry).join(",")))
         .collect();
     format!("[[{}],{}]", rows.join(","), json_point(&t))
 }

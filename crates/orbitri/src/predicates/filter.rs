@@ -171,6 +171,64 @@ pub fn in_circle(d: &[[f64; 2]; 3], b: [f64; 3]) -> Option<Sign> {
     decide(det, 1024.0 * U * bmax * b[0] * b[1] * b[2])
 }
 
+/// In-sphere determinant for rows `d_i = a_i − q` (bounds `b`, `N = D + 1`, `D` 2 or 3) in
+/// coordinates whose squared length is `xᵀ·G·x`: positive when `q` is inside the sphere of
+/// the positively oriented `a_0..a_D`. `g` holds `G`'s entries, each within `u` of the exact
+/// one relative to it, and `gsum` their absolute sum, at most 2.
+///
+/// Bound: each lifted length `l_i = Σ G_jk d_ij d_ik` is at most `gsum·B_i²` and off by at
+/// most `(12.1 + 1 + 2 + D²)u` of that (inputs, `G`, two products, the sum); each minor's
+/// `D!` products of `D` entries are off by `(6.1D + D − 1 + D!)u` of `D!·ΠB`; the
+/// `(D+1)·D!` terms `l_i·(product)` are each at most `gsum·B_max·ΠB`: below `1260u` of
+/// `gsum·B_max·ΠB` in 3D and `240u` in 2D, bounded by `2048u` and `512u`. Entries of `G`
+/// below `2⁻⁶⁰` of the largest are refused by the caller, so nothing underflows.
+#[inline]
+pub fn in_sphere_metric<const D: usize, const N: usize>(
+    d: &[[f64; D]; N],
+    b: [f64; N],
+    g: &[[f64; D]; D],
+    gsum: f64,
+) -> Option<Sign> {
+    if !b.iter().all(|&x| in_range(x)) {
+        return None;
+    }
+    let l: [f64; N] = std::array::from_fn(|i| {
+        let mut s = 0.0;
+        for j in 0..D {
+            for k in 0..D {
+                s += g[j][k] * d[i][j] * d[i][k];
+            }
+        }
+        s
+    });
+    let mut det = 0.0;
+    for (i, li) in l.iter().enumerate() {
+        let mut rows = [&[][..]; 3];
+        for (slot, k) in (0..N).filter(|&k| k != i).enumerate() {
+            rows[slot] = &d[k][..];
+        }
+        let minor = if D == 2 {
+            rows[0][0] * rows[1][1] - rows[0][1] * rows[1][0]
+        } else {
+            rows[0][0] * (rows[1][1] * rows[2][2] - rows[1][2] * rows[2][1])
+                - rows[0][1] * (rows[1][0] * rows[2][2] - rows[1][2] * rows[2][0])
+                + rows[0][2] * (rows[1][0] * rows[2][1] - rows[1][1] * rows[2][0])
+        };
+        // cofactor sign along the last column of the (D+1)×(D+1) matrix
+        if (i + D) & 1 == 0 {
+            det += li * minor;
+        } else {
+            det -= li * minor;
+        }
+    }
+    let bmax = b.iter().fold(0.0f64, |m, &x| m.max(x));
+    let prod: f64 = b.iter().product();
+    let c = if D == 2 { 512.0 } else { 2048.0 };
+    // inside ⇔ the determinant has the sign of (−1)^D
+    let inside = if D & 1 == 0 { det } else { -det };
+    decide(inside, c * U * gsum * bmax * prod)
+}
+
 /// The sign of `det` when its error is below `err`; an exact zero when everything is zero.
 #[inline]
 fn decide(det: f64, err: f64) -> Option<Sign> {

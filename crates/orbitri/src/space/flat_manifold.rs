@@ -17,6 +17,7 @@
 
 use super::flat_torus::{perturbed_by, UnperturbedInSphere, L};
 use super::lattice::{Ladder, Level};
+use super::metric::Gram;
 use super::{least_frame, least_translate, FlatSpace, FlatTorus, Lattice, OrbitSpace};
 use crate::error::{Error, Result};
 use crate::predicates::Sign;
@@ -39,16 +40,64 @@ pub struct Coset<const D: usize> {
     pub shift: [i32; D],
 }
 
+/// How a coset's linear part acts on stored coordinates, exactly.
+#[derive(Clone, Debug)]
+enum Action<const D: usize> {
+    /// Cartesian coordinates: output coordinate `i` is `sign·x_j`, as `(j, sign)`.
+    Permute([(usize, f64); D]),
+    /// Lattice coordinates: output coordinate `i` is `Σ_j a_ij·x_j` with integers `a_ij`,
+    /// exact on the grid the stored coordinates are rounded to.
+    Integer([[f64; D]; D]),
+}
+
+impl<const D: usize> Action<D> {
+    #[inline(always)]
+    fn apply(&self, p: &[f64; D]) -> [f64; D] {
+        match self {
+            Action::Permute(perm) => std::array::from_fn(|i| {
+                let (j, sign) = perm[i];
+                sign * p[j]
+            }),
+            Action::Integer(a) => std::array::from_fn(|i| {
+                let mut s = 0.0;
+                for j in 0..D {
+                    if a[i][j] != 0.0 {
+                        s += a[i][j] * p[j];
+                    }
+                }
+                s
+            }),
+        }
+    }
+}
+
+/// A coset of a lattice frame: `(R, s, A)`, see [`FlatManifold::in_lattice_frame`].
+pub(super) type LatticeCoset<const D: usize> = ([[i32; D]; D], [i32; D], [[f64; D]; D]);
+
 /// A coset with what the group law needs.
 #[derive(Clone, Debug)]
 struct CosetData<const D: usize> {
-    /// Output coordinate `i` is `sign·x_j`: `(j, sign)`.
-    perm: [(usize, f64); D],
-    linear: [[i32; D]; D],
+    action: Action<D>,
+    /// `A` in Cartesian coordinates (rounded when irrational).
+    linear: [[f64; D]; D],
     /// The action of `A` on lattice coordinates: `A·(o·M) = (o·R)·M`.
     r: [[i32; D]; D],
     shift: [i32; D],
     reverses: bool,
+}
+
+/// The frame of a manifold whose linear parts are not signed permutations (a hexagonal
+/// cross-section turned by a third or a sixth): points are stored in the coordinates of the
+/// lattice `M/q`, rounded to a grid on which the cosets' integer actions are exact, and
+/// the predicates use the lattice's exact Gram matrix.
+#[derive(Clone, Debug)]
+struct LatticeFrame<const D: usize> {
+    /// The torus of the identity lattice: exact orientation, coincidence and order of
+    /// lifted points in lattice coordinates.
+    unit: FlatTorus<D>,
+    gram: Gram<D>,
+    /// The grid spacing per coordinate (a power of two).
+    quantum: [f64; D],
 }
 
 /// A closed flat manifold: the orbit space of a Bieberbach group.
@@ -71,9 +120,16 @@ pub struct FlatManifold<const D: usize> {
     /// The domain is the part of `T`'s domain whose fractional coordinate along this axis
     /// is below `1/k`.
     slab_axis: usize,
+    /// `T`'s internal length unit over the fine lattice's (`q` when `q` is a power of two).
+    scale: f64,
+    /// A bound on the diameter `Δ` of the largest empty ball of one point's orbit, internal
+    /// frame.
+    orbit_gap: f64,
+    /// `None`: stored points are Cartesian (the fine torus's internal frame).
+    lattice_frame: Option<Box<LatticeFrame<D>>>,
 }
 
-fn mat_mul<const D: usize>(a: &[[i32; D]; D], b: &[[i32; D]; D]) -> [[i32; D]; D] {
+pub(super) fn mat_mul<const D: usize>(a: &[[i32; D]; D], b: &[[i32; D]; D]) -> [[i32; D]; D] {
     std::array::from_fn(|i| std::array::from_fn(|j| (0..D).map(|k| a[i][k] * b[k][j]).sum()))
 }
 
@@ -92,6 +148,11 @@ fn det<const D: usize>(a: &[[i32; D]; D]) -> i32 {
         }
         _ => unreachable!("dimension 2 or 3"),
     }
+}
+
+/// `Aᵀ·v`: the inverse of an orthogonal linear part applied to a vector.
+fn transpose_times<const D: usize>(a: &[[f64; D]; D], v: &[f64; D]) -> [f64; D] {
+    std::array::from_fn(|j| (0..D).map(|i| a[i][j] * v[i]).sum())
 }
 
 /// Offsets are bounded by construction; overflowing them is a bug, and it must stop the
@@ -161,36 +222,30 @@ impl<const D: usize> FlatManifold<D> {
         slab_axis: usize,
     ) -> Result<Self> {
         let translations = Lattice::new(rows)?;
-        let fine_rows = rows.map(|r| r.map(|x| x / q as f64));
-        let fine = FlatTorus::with_ladder(Lattice::new(fine_rows)?, Ladder::Grid);
-        if translations.unit() != fine.lattice().unit() * q as f64 {
-            return Err(Error::InvalidBox(format!(
-                "{name}: the box is too close to the limits of the doubles"
-            )));
-        }
-        let k = cosets.len();
-        if k == 0
-            || cosets[0].linear != std::array::from_fn(|i| std::array::from_fn(|j| (i == j) as i8))
-            || cosets[0].shift != [0; D]
+        let identity: [[i8; D]; D] =
+            std::array::from_fn(|i| std::array::from_fn(|j| (i == j) as i8));
+        if cosets
+            .first()
+            .is_none_or(|c| c.linear != identity || c.shift != [0; D])
         {
             return Err(not_a_group("the first coset must be the identity".into()));
         }
-        let mut data = Vec::with_capacity(k);
+        let mut data = Vec::with_capacity(cosets.len());
         for (c, co) in cosets.iter().enumerate() {
-            let linear = co.linear.map(|r| r.map(|x| x as i32));
+            let linear = co.linear.map(|r| r.map(|x| x as f64));
             let mut perm = [(0usize, 0.0f64); D];
             for i in 0..D {
-                let nz: Vec<usize> = (0..D).filter(|&j| linear[i][j] != 0).collect();
-                if nz.len() != 1 || linear[i][nz[0]].abs() != 1 {
+                let nz: Vec<usize> = (0..D).filter(|&j| linear[i][j] != 0.0).collect();
+                if nz.len() != 1 || linear[i][nz[0]].abs() != 1.0 {
                     return Err(not_a_group(format!(
                         "coset {c} is not a signed permutation"
                     )));
                 }
-                perm[i] = (nz[0], linear[i][nz[0]] as f64);
+                perm[i] = (nz[0], linear[i][nz[0]]);
             }
             // R = M·Aᵀ·M⁻¹, rounded and confirmed: A maps the lattice onto itself
             let image: [[f64; D]; D] = std::array::from_fn(|kk| {
-                std::array::from_fn(|i| (0..D).map(|j| linear[i][j] as f64 * rows[kk][j]).sum())
+                std::array::from_fn(|i| (0..D).map(|j| linear[i][j] * rows[kk][j]).sum())
             });
             let r_f: [[f64; D]; D] = image.map(|v| translations.fractional(&v));
             let r = r_f.map(|row| row.map(|x| x.round() as i32));
@@ -205,18 +260,102 @@ impl<const D: usize> FlatManifold<D> {
                 )));
             }
             data.push(CosetData {
-                perm,
+                action: Action::Permute(perm),
                 linear,
                 r,
                 shift: co.shift,
-                reverses: det(&linear) < 0,
+                reverses: det(&r) < 0,
             });
         }
+        Self::assemble(name, translations, q, data, slab_axis, None)
+    }
+
+    /// The manifold of the translations by `rows` (user units, only used approximately)
+    /// whose metric in the coordinates of `rows` is exactly `gram`, and whose cosets are
+    /// `(R, s, A)`: `R` the action on lattice coordinates (`A·(o·M) = (o·R)·M`), `s` the
+    /// translation in units of `rows/q`, `A` the Cartesian linear part (for output). Points
+    /// are stored in lattice coordinates, so nothing irrational is ever computed exactly.
+    pub(super) fn in_lattice_frame(
+        name: &'static str,
+        rows: [[f64; D]; D],
+        gram: Gram<D>,
+        q: i32,
+        cosets: &[LatticeCoset<D>],
+        slab_axis: usize,
+    ) -> Result<Self> {
+        let translations = Lattice::new(rows)?;
+        let identity: [[i32; D]; D] =
+            std::array::from_fn(|i| std::array::from_fn(|j| (i == j) as i32));
+        if cosets
+            .first()
+            .is_none_or(|c| c.0 != identity || c.1 != [0; D])
+        {
+            return Err(not_a_group("the first coset must be the identity".into()));
+        }
+        let data: Vec<CosetData<D>> = cosets
+            .iter()
+            .map(|&(r, shift, linear)| CosetData {
+                // output coordinate j of x·R is Σ_i x_i·R_ij
+                action: Action::Integer(std::array::from_fn(|j| {
+                    std::array::from_fn(|i| r[i][j] as f64)
+                })),
+                linear,
+                r,
+                shift,
+                reverses: det(&r) < 0,
+            })
+            .collect();
+        // the grid: every sum an action or a shift forms stays below 2^53 quanta
+        let quantum: [f64; D] = std::array::from_fn(|j| {
+            let reach = data
+                .iter()
+                .map(|c| (0..D).map(|i| c.r[i][j].abs()).sum::<i32>() * q + c.shift[j].abs() + q)
+                .max()
+                .unwrap_or(q);
+            2f64.powi((reach as f64).log2().ceil() as i32 - 52)
+        });
+        let frame = LatticeFrame {
+            unit: FlatTorus::with_ladder(
+                Lattice::new(identity.map(|r| r.map(|x| x as f64)))?,
+                Ladder::Grid,
+            ),
+            gram,
+            quantum,
+        };
+        Self::assemble(
+            name,
+            translations,
+            q,
+            data,
+            slab_axis,
+            Some(Box::new(frame)),
+        )
+    }
+
+    /// The group law's tables, the ladder and the systole, shared by both frames.
+    fn assemble(
+        name: &'static str,
+        translations: Lattice<D>,
+        q: i32,
+        data: Vec<CosetData<D>>,
+        slab_axis: usize,
+        lattice_frame: Option<Box<LatticeFrame<D>>>,
+    ) -> Result<Self> {
+        let fine_rows = translations.vectors().map(|r| r.map(|x| x / q as f64));
+        let fine = FlatTorus::with_ladder(Lattice::new(fine_rows)?, Ladder::Grid);
+        let scale = translations.unit() / fine.lattice().unit();
+        if lattice_frame.is_none() && scale != q as f64 {
+            return Err(Error::InvalidBox(format!(
+                "{name}: the box is too close to the limits of the doubles"
+            )));
+        }
+        let k = data.len();
         let mut product = Vec::with_capacity(k * k);
         for a in 0..k {
             for b in 0..k {
-                let lin = mat_mul(&data[a].linear, &data[b].linear);
-                let Some(c) = (0..k).find(|&c| data[c].linear == lin) else {
+                // r_a∘r_b acts on lattice coordinates by R_b·R_a
+                let lin = mat_mul(&data[b].r, &data[a].r);
+                let Some(c) = (0..k).find(|&c| data[c].r == lin) else {
                     return Err(not_a_group(format!(
                         "the product of cosets {a} and {b} is no coset"
                     )));
@@ -237,12 +376,13 @@ impl<const D: usize> FlatManifold<D> {
             .map(|a| (0..k).find(|&b| product[a * k + b].0 == 0).map(|b| b as u8))
             .collect::<Option<Vec<u8>>>()
             .ok_or_else(|| not_a_group("a coset has no inverse".into()))?;
+        let need = one_point_need(&translations, k, slab_axis);
         let ladder = translations
-            .grid_ladder_for(one_point_need(&translations, k, slab_axis))
+            .grid_ladder_for(need)
             .into_iter()
             .map(|l| Level {
                 sub: l.sub,
-                systole: l.systole * q as f64,
+                systole: l.systole * scale,
             })
             .collect::<Vec<_>>();
         let widest = (0..D).map(|c| ladder[0].sub.span(c)).max().unwrap_or(1);
@@ -262,6 +402,9 @@ impl<const D: usize> FlatManifold<D> {
             ladder,
             systole: 0.0,
             slab_axis,
+            scale,
+            orbit_gap: need / 2.0 * scale,
+            lattice_frame,
         };
         m.systole = m.least_displacement();
         if m.systole.is_nan() || m.systole <= 0.0 {
@@ -307,10 +450,7 @@ impl<const D: usize> FlatManifold<D> {
         let c = &self.cosets[g.coset as usize];
         let frac: [f64; D] =
             std::array::from_fn(|i| (c.shift[i] + self.q * g.offset[i] as i32) as f64);
-        (
-            c.linear.map(|r| r.map(|x| x as f64)),
-            self.fine.lattice().cartesian(&frac),
-        )
+        (c.linear, self.fine.lattice().cartesian(&frac))
     }
 
     /// Generators of the group as isometries: the lattice translations and the coset
@@ -339,30 +479,20 @@ impl<const D: usize> FlatManifold<D> {
     /// coordinates (the slab axis first) is kept; moving it may round, as wrapping into a
     /// torus does.
     pub(crate) fn canonical(&self, x: [f64; D]) -> Option<([f64; D], bool)> {
+        if let Some(frame) = &self.lattice_frame {
+            return self.canonical_in_lattice(frame, x);
+        }
         let (y, mut moved) = self.translations.wrap(x)?;
         // the slab axis first, then the others: images tied along the axis (on a boundary
         // of the slab) are told apart by the rest
-        let key_of = |z: &[f64; D]| {
-            let f = self.translations.fractional(z);
-            let mut k = [f[self.slab_axis]; D];
-            let others = (0..D).filter(|&i| i != self.slab_axis);
-            for (slot, i) in others.enumerate() {
-                k[slot + 1] = f[i];
-            }
-            k
-        };
+        let key_of = |z: &[f64; D]| self.slab_first(self.translations.fractional(z));
         let mut best = y;
         let mut key = key_of(&y);
         for c in self.cosets.iter().skip(1) {
             // r_c⁻¹(y) = Aᵀ·(y − s/q·M)
             let t = self.fine.lattice().cartesian(&c.shift.map(|s| s as f64));
             let d: [f64; D] = std::array::from_fn(|i| y[i] - t[i]);
-            let mut z = [0.0; D];
-            for i in 0..D {
-                let (j, sign) = c.perm[i];
-                z[j] = sign * d[i];
-            }
-            let (z, _) = self.translations.wrap(z)?;
+            let (z, _) = self.translations.wrap(transpose_times(&c.linear, &d))?;
             let kz = key_of(&z);
             if kz < key {
                 (best, key, moved) = (z, kz, true);
@@ -371,20 +501,97 @@ impl<const D: usize> FlatManifold<D> {
         Some((self.fine.lattice().to_internal(best), moved))
     }
 
-    /// The lifted point `g·p` as a lifted point of the torus of `M/q`.
+    /// Fractional coordinates reordered with the slab axis first: the order in which the
+    /// images of a point compete for the domain (images tied along the axis, on a boundary of
+    /// the slab, are told apart by the rest).
+    fn slab_first(&self, f: [f64; D]) -> [f64; D] {
+        let mut k = [f[self.slab_axis]; D];
+        let others = (0..D).filter(|&i| i != self.slab_axis);
+        for (slot, i) in others.enumerate() {
+            k[slot + 1] = f[i];
+        }
+        k
+    }
+
+    /// [`Self::canonical`] in a lattice frame: the user's point in coordinates of `M/q`,
+    /// wrapped into `T`'s domain and rounded to the frame's grid; of its `k` images there
+    /// (exact on the grid), the one with the least coordinates, the slab axis first.
+    fn canonical_in_lattice(
+        &self,
+        frame: &LatticeFrame<D>,
+        x: [f64; D],
+    ) -> Option<([f64; D], bool)> {
+        let q = self.q as f64;
+        let f = self.translations.fractional(&x);
+        if f.iter().any(|v| v.is_nan() || v.abs() >= 2f64.powi(40)) {
+            return None;
+        }
+        let wrap = |v: f64| {
+            if v >= q {
+                v - q
+            } else if v < 0.0 {
+                v + q
+            } else {
+                v
+            }
+        };
+        let u: [f64; D] = std::array::from_fn(|j| {
+            let grid = frame.quantum[j];
+            wrap(((f[j] - f[j].floor()) * q / grid).round() * grid)
+        });
+        let mut best = u;
+        let mut key = self.slab_first(u);
+        for c in self.cosets.iter().skip(1) {
+            let y = c.action.apply(&u);
+            let z: [f64; D] = std::array::from_fn(|j| {
+                let v = y[j] + c.shift[j] as f64;
+                v - q * (v / q).floor()
+            });
+            let kz = self.slab_first(z);
+            if kz < key {
+                (best, key) = (z, kz);
+            }
+        }
+        let back = self
+            .fine
+            .lattice()
+            .to_user(self.position(&best, self.identity_motion()));
+        Some((best, back != x))
+    }
+
+    fn identity_motion(&self) -> Motion<D> {
+        Motion {
+            coset: 0,
+            offset: [0; D],
+        }
+    }
+
+    /// The lifted point `g·p` as a lifted point of the torus of `M/q` in the stored frame:
+    /// Cartesian, or lattice coordinates (then see [`Self::cartesian`]).
     #[inline(always)]
     fn lift(&self, (p, g): (&[f64; D], Motion<D>)) -> L<D> {
         let c = &self.cosets[g.coset as usize];
-        let x = std::array::from_fn(|i| {
-            let (j, sign) = c.perm[i];
-            sign * p[j]
-        });
+        let x = c.action.apply(p);
         let t: [i32; D] = std::array::from_fn(|i| c.shift[i] + self.q * g.offset[i] as i32);
         (x, narrow(t))
     }
 
     fn lift_all<const N: usize>(&self, s: &[(P<D>, Motion<D>); N]) -> [L<D>; N] {
         std::array::from_fn(|i| self.lift((&s[i].0, s[i].1)))
+    }
+
+    /// A lifted point of the stored frame as a lifted point of the Cartesian torus of
+    /// `M/q` (rounded in a lattice frame): what constructions and distances use.
+    #[inline(always)]
+    fn cartesian(&self, l: L<D>) -> L<D> {
+        match &self.lattice_frame {
+            None => l,
+            Some(_) => (self.fine.lattice().cartesian_in(&l.0), l.1),
+        }
+    }
+
+    fn cartesian_all<const N: usize>(&self, s: &[(P<D>, Motion<D>); N]) -> [L<D>; N] {
+        std::array::from_fn(|i| self.cartesian(self.lift((&s[i].0, s[i].1))))
     }
 
     #[inline]
@@ -436,11 +643,11 @@ impl<const D: usize> FlatManifold<D> {
         let side = (2 * span + 1) as usize;
         for (c, co) in self.cosets.iter().enumerate() {
             // the projection onto the fixed space of A
-            let mut power = co.linear;
-            let mut sum = co.linear;
+            let mut power = co.r;
+            let mut sum = co.r;
             let mut order = 1;
             while power != std::array::from_fn(|i| std::array::from_fn(|j| (i == j) as i32)) {
-                power = mat_mul(&power, &co.linear);
+                power = mat_mul(&power, &co.r);
                 for i in 0..D {
                     for j in 0..D {
                         sum[i][j] += power[i][j];
@@ -458,11 +665,10 @@ impl<const D: usize> FlatManifold<D> {
                 if c == 0 && o == [0; D] {
                     continue;
                 }
-                let frac: [f64; D] = std::array::from_fn(|i| (co.shift[i] + self.q * o[i]) as f64);
-                let t = self.fine.lattice().cartesian_in(&frac);
-                let proj: [f64; D] = std::array::from_fn(|i| {
-                    (0..D).map(|j| sum[i][j] as f64 * t[j]).sum::<f64>() / order as f64
-                });
+                // the projection t·(Σ R^i)/order in lattice coordinates, then Cartesian
+                let t: [i32; D] = std::array::from_fn(|i| co.shift[i] + self.q * o[i]);
+                let frac = row_times(t, &sum).map(|x| x as f64 / order as f64);
+                let proj = self.fine.lattice().cartesian_in(&frac);
                 best = best.min(proj.iter().map(|x| x * x).sum::<f64>().sqrt());
             }
         }
@@ -482,11 +688,35 @@ impl<const D: usize> FlatManifold<D> {
 
     /// The position of a lifted point in the internal frame, rounded.
     fn position(&self, p: &[f64; D], g: Motion<D>) -> [f64; D] {
-        self.fine.position(self.lift((p, g)))
+        self.fine.position(self.cartesian(self.lift((p, g))))
     }
 }
 
 type P<const D: usize> = [f64; D];
+
+impl<const D: usize> FlatManifold<D> {
+    /// The torus whose exact orientation, coincidence and order the stored frame uses.
+    #[inline(always)]
+    fn kernel(&self) -> &FlatTorus<D> {
+        match &self.lattice_frame {
+            None => &self.fine,
+            Some(f) => &f.unit,
+        }
+    }
+
+    /// The exact in-sphere sign of lifted points of the stored frame, `Zero` when
+    /// cospherical.
+    #[inline]
+    fn in_sphere_unperturbed<const N: usize>(&self, s: &[L<D>; N], q: L<D>) -> Sign
+    where
+        FlatTorus<D>: UnperturbedInSphere<D, N>,
+    {
+        match &self.lattice_frame {
+            None => self.fine.in_sphere_unperturbed(s, q),
+            Some(f) => f.gram.in_sphere(&f.unit, s, q),
+        }
+    }
+}
 
 impl<const D: usize, const N: usize> OrbitSpace<N> for FlatManifold<D>
 where
@@ -554,29 +784,32 @@ where
 
     #[inline]
     fn orient(&self, s: &[(P<D>, Motion<D>); N]) -> Sign {
-        self.fine.orient(&self.lift_all(s))
+        let ls = self.lift_all(s);
+        match &self.lattice_frame {
+            None => self.fine.orient(&ls),
+            Some(f) => f.unit.orient(&ls),
+        }
     }
 
     fn in_sphere(&self, s: &[(P<D>, Motion<D>); N], q: (P<D>, Motion<D>)) -> Sign {
         let ls = self.lift_all(s);
         let lq = self.lift((&q.0, q.1));
-        match self.fine.in_sphere_unperturbed(&ls, lq) {
+        match self.in_sphere_unperturbed(&ls, lq) {
             Sign::Zero => {
                 // one global order: distinct points by their stored coordinates (invariant
                 // under the group), copies of one point by their lifted positions (invariant
                 // under translations: copies meet in one test only in a covering, whose
                 // group is translations)
+                let kernel = self.kernel();
                 let at = |k: usize| if k == N { (q.0, lq) } else { (s[k].0, ls[k]) };
                 perturbed_by(
                     &ls,
                     lq,
-                    |t| self.fine.orient(t),
+                    |t| kernel.orient(t),
                     |a, b| {
                         let ((pa, la), (pb, lb)) = (at(a), at(b));
                         match pa.partial_cmp(&pb) {
-                            Some(std::cmp::Ordering::Equal) | None => {
-                                self.fine.compare_lifted(la, lb)
-                            }
+                            Some(std::cmp::Ordering::Equal) | None => kernel.compare_lifted(la, lb),
                             Some(o) => Sign::from(o),
                         }
                     },
@@ -587,22 +820,20 @@ where
     }
 
     fn cospherical(&self, s: &[(P<D>, Motion<D>); N], q: (P<D>, Motion<D>)) -> bool {
-        self.fine
-            .in_sphere_unperturbed(&self.lift_all(s), self.lift((&q.0, q.1)))
-            == Sign::Zero
+        self.in_sphere_unperturbed(&self.lift_all(s), self.lift((&q.0, q.1))) == Sign::Zero
     }
 
     fn coincide(&self, a: (P<D>, Motion<D>), b: (P<D>, Motion<D>)) -> bool {
-        self.fine
+        self.kernel()
             .coincide(self.lift((&a.0, a.1)), self.lift((&b.0, b.1)))
     }
 
     fn circumradius2(&self, s: &[(P<D>, Motion<D>); N]) -> f64 {
-        self.fine.circumradius2(&self.lift_all(s))
+        self.fine.circumradius2(&self.cartesian_all(s))
     }
 
     fn circumcenter(&self, s: &[(P<D>, Motion<D>); N]) -> P<D> {
-        self.fine.circumcenter(&self.lift_all(s))
+        self.fine.circumcenter(&self.cartesian_all(s))
     }
 
     fn levels(&self) -> usize {
@@ -665,13 +896,21 @@ where
 
     fn dummy_points(&self) -> Vec<P<D>> {
         // a grid over T's domain fine enough for δ(G), of which the slab is kept (its images
-        // fill the rest); T's internal frame is the manifold's divided by q (exactly)
-        let q = self.q as f64;
-        self.translations
-            .dummy_grid_for(self.systole / q, self.slab_axis, self.cosets.len())
+        // fill the rest); T's internal frame is the manifold's divided by `scale` (exactly)
+        let grid = self
+            .translations
+            .dummy_grid_for(self.systole / self.scale, self.slab_axis, self.cosets.len())
             .into_iter()
-            .map(|p| p.map(|x| x * q))
-            .collect()
+            .map(|p| p.map(|x| x * self.scale));
+        match &self.lattice_frame {
+            None => grid.collect(),
+            Some(f) => grid
+                .map(|p| {
+                    let u = self.fine.lattice().fractional_in(&p);
+                    std::array::from_fn(|j| (u[j] / f.quantum[j]).round() * f.quantum[j])
+                })
+                .collect(),
+        }
     }
 
     fn sheets(&self, level: usize) -> usize {
@@ -752,22 +991,17 @@ where
         } else if level > 0 {
             self.ladder[level].systole / 2.0
         } else {
-            // the largest empty ball of one point of T: diameter ≤ √(Σ|b_i|²)
-            let m = &self.fine.lattice().rows.m;
-            (0..D)
-                .map(|i| {
-                    m[i].iter()
-                        .map(|x| x * x * self.q as f64 * self.q as f64)
-                        .sum::<f64>()
-                })
-                .sum::<f64>()
-                .sqrt()
+            // the largest empty ball one point's orbit leaves bounds every edge
+            self.orbit_gap
         }
     }
 
     fn spatial_key(&self, p: &P<D>) -> u64 {
         let bits = if D == 3 { 21 } else { 16 };
-        let f = self.fine.lattice().fractional_in(p);
+        let f = match &self.lattice_frame {
+            None => self.fine.lattice().fractional_in(p),
+            Some(_) => *p,
+        };
         let scale = (1u64 << bits) as f64;
         let cell: [u32; D] =
             f.map(|v| ((v / self.q as f64).clamp(0.0, 1.0) * scale).min(scale - 1.0) as u32);
@@ -796,22 +1030,19 @@ where
     }
 
     fn lifted_difference(&self, a: (P<D>, Motion<D>), b: (P<D>, Motion<D>)) -> [f64; D] {
-        self.fine
-            .lifted_difference(self.lift((&a.0, a.1)), self.lift((&b.0, b.1)))
+        self.fine.lifted_difference(
+            self.cartesian(self.lift((&a.0, a.1))),
+            self.cartesian(self.lift((&b.0, b.1))),
+        )
     }
 
     fn untwist(&self, g: Motion<D>, v: [f64; D]) -> [f64; D] {
-        let c = &self.cosets[g.coset as usize];
-        let mut z = [0.0; D];
-        for i in 0..D {
-            let (j, sign) = c.perm[i];
-            z[j] = sign * v[i];
-        }
-        z
+        transpose_times(&self.cosets[g.coset as usize].linear, &v)
     }
 
     fn relating(&self, from: [f64; D], to: [f64; D]) -> Option<Motion<D>> {
         let lat = self.fine.lattice();
+        let target = self.position(&to, self.identity_motion());
         (0..self.cosets.len() as u8).find_map(|coset| {
             let base = self.position(
                 &from,
@@ -820,7 +1051,7 @@ where
                     offset: [0; D],
                 },
             );
-            let d: [f64; D] = std::array::from_fn(|c| to[c] - base[c]);
+            let d: [f64; D] = std::array::from_fn(|c| target[c] - base[c]);
             let o = lat.fractional_in(&d).map(|x| (x / self.q as f64).round());
             if o.iter().any(|x| x.abs() > 30.0) {
                 return None;
@@ -829,7 +1060,7 @@ where
                 coset,
                 offset: o.map(|x| x as i8),
             };
-            self.fine
+            self.kernel()
                 .coincide(self.lift((&from, g)), (to, [0; D]))
                 .then_some(g)
         })
@@ -1020,10 +1251,12 @@ mod tests {
     #[test]
     fn first_homology_names_each_space() {
         let b = [1.0, 1.0, 1.25];
-        let expect: [(&str, usize, &[i64]); 8] = [
+        let expect: [(&str, usize, &[i64]); 10] = [
             ("torocosm", 3, &[]),
             ("dicosm", 1, &[2, 2]),
+            ("tricosm", 1, &[3]),
             ("tetracosm", 1, &[2]),
+            ("hexacosm", 1, &[]),
             ("didicosm", 0, &[4, 4]),
             ("first-amphicosm", 2, &[2]),
             ("second-amphicosm", 2, &[]),

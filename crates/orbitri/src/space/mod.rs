@@ -7,6 +7,7 @@ mod flat_torus2;
 mod flat_torus3;
 mod klein_bottle;
 mod lattice;
+mod metric;
 mod platycosms;
 mod sublattice;
 

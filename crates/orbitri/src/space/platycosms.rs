@@ -1,30 +1,74 @@
-//! The closed flat 3-manifolds (Conway–Rossetti's platycosms) whose holonomy acts by signed
-//! permutations, each in a standard presentation whose fundamental domain is the box
-//! `[0, L1) × [0, L2) × [0, L3)` (sheared in the second amphicosm): the translations `T`
-//! are given by their lattice rows, the other cosets by `x ↦ A·x + t`.
+//! The ten closed flat 3-manifolds (Conway–Rossetti's platycosms), each in a standard
+//! presentation whose fundamental domain is the box `[0, L1) × [0, L2) × [0, L3)` (sheared
+//! in the second amphicosm; a 60° rhombus of side `L1` times `[0, L3)` for the tricosm and
+//! hexacosm): the translations `T` are given by their lattice rows, the other cosets by
+//! `x ↦ A·x + t`. `a1 = (1, 0, 0)` and `a2 = (½, √3/2, 0)` span a hexagonal cross-section.
 //!
 //! | name | generators besides `T` | `T` | index |
 //! |---|---|---|---|
 //! | torocosm | — | `L1 e1, L2 e2, L3 e3` | 1 |
 //! | dicosm | `(x, y, z) ↦ (−x, −y, z + L3)` | `L1 e1, L2 e2, 2L3 e3` | 2 |
+//! | tricosm (`L1 = L2`) | a third of a turn about `e3`, then `+ L3 e3` | `L1 a1, L1 a2, 3L3 e3` | 3 |
 //! | tetracosm (`L1 = L2`) | `(x, y, z) ↦ (−y, x, z + L3)` | `L1 e1, L1 e2, 4L3 e3` | 4 |
+//! | hexacosm (`L1 = L2`) | a sixth of a turn about `e3`, then `+ L3 e3` | `L1 a1, L1 a2, 6L3 e3` | 6 |
 //! | didicosm | `(x + 2L1, −y + L2/2, −z)`, `(−x, y + L2/2, −z + L3/2)` | `4L1 e1, L2 e2, L3 e3` | 4 |
 //! | first amphicosm | `(x, y, z) ↦ (x + L1, −y, z)` | `2L1 e1, L2 e2, L3 e3` | 2 |
 //! | second amphicosm | `(x, y, z) ↦ (x + L1, −y, z)` | `2L1 e1, L2 e2, L2/2 e2 + L3 e3` | 2 |
 //! | first amphidicosm | `(−x, −y, z + L3/2)`, `(x + 2L1, −y, z)` | `4L1 e1, L2 e2, L3 e3` | 4 |
 //! | second amphidicosm | `(−x, −y, z + L3/2)`, `(x + 2L1, −y + L2/2, z)` | `4L1 e1, L2 e2, L3 e3` | 4 |
 //!
-//! The dicosm and the tetracosm screw along the third axis (`L3` is the length along it);
-//! the didicosm (Hantzsche–Wendt) has three screw axes, one per coordinate axis; the
-//! amphicosms glide along the first axis and reflect the second; the amphidicosms screw
-//! half a turn about the third axis and glide along the first in mirrors across the second.
-//! Their first homology groups tell them apart (`Z³`, `Z ⊕ Z₂²`, `Z ⊕ Z₂`, `Z₄²`,
-//! `Z² ⊕ Z₂`, `Z²`, `Z ⊕ Z₂²`, `Z ⊕ Z₄`, in the order of the table), which the tests check. The fundamental domain is
-//! the slab of `T`'s domain below `1/index` along the axis the cosets shift (the third for
-//! the screws, the first otherwise).
+//! The dicosm, tricosm, tetracosm and hexacosm screw along the third axis (`L3` is the
+//! advance of one screw); the didicosm (Hantzsche–Wendt) has three screw axes, one per
+//! coordinate axis; the amphicosms glide along the first axis and reflect the second; the
+//! amphidicosms screw half a turn about the third axis and glide along the first in mirrors
+//! across the second. Their first homology groups tell them apart (`Z³`, `Z ⊕ Z₂²`,
+//! `Z ⊕ Z₃`, `Z ⊕ Z₂`, `Z`, `Z₄²`, `Z² ⊕ Z₂`, `Z²`, `Z ⊕ Z₂²`, `Z ⊕ Z₄`, in the order of
+//! the table), which the tests check. The fundamental domain is the slab of `T`'s domain
+//! below `1/index` along the axis the cosets shift (the third for the screws, the first
+//! otherwise). The tricosm and hexacosm store their points in lattice coordinates (see
+//! [`FlatManifold`]'s lattice frame and `metric.rs`).
 
-use super::flat_manifold::{Coset, FlatManifold};
+use super::flat_manifold::{mat_mul, Coset, FlatManifold};
+use super::metric::Gram;
 use crate::error::{Error, Result};
+
+/// The screw by `1/turns` of a turn (3 or 6) about the third axis, advancing `l3`, over the
+/// hexagonal lattice of side `l1`: `T` has rows `a1 = l1·e1`, `a2 = l1·(½, √3/2, 0)` and
+/// `turns·l3·e3`. In lattice coordinates the sixth of a turn maps `a1 ↦ a2` and
+/// `a2 ↦ a2 − a1`, an integer matrix; the Gram matrix of `(a1, a2, a3)` is
+/// `[[l1², l1²/2, 0], [l1²/2, l1², 0], [0, 0, (turns·l3)²]]`, used doubled to be integral.
+fn hexagonal_screw(name: &'static str, l1: f64, l3: f64, turns: i32) -> Result<FlatManifold<3>> {
+    let s = 3f64.sqrt() / 2.0;
+    let lz = turns as f64 * l3;
+    let rows = [[l1, 0.0, 0.0], [l1 / 2.0, l1 * s, 0.0], [0.0, 0.0, lz]];
+    let zz = 2 * (turns as i64) * (turns as i64);
+    let gram = Gram::new([
+        [(2, l1), (1, l1), (0, 0.0)],
+        [(1, l1), (2, l1), (0, 0.0)],
+        [(0, 0.0), (0, 0.0), (zz, l3)],
+    ])?;
+    let sixth = [[0, 1, 0], [-1, 1, 0], [0, 0, 1]];
+    let step = if turns == 3 {
+        mat_mul(&sixth, &sixth)
+    } else {
+        sixth
+    };
+    // cos and sin of the multiples of 60°, exact but for √3/2
+    let (cos, sin) = ([1.0, 0.5, -0.5, -1.0, -0.5, 0.5], [0.0, s, s, 0.0, -s, -s]);
+    let mut r = [[1, 0, 0], [0, 1, 0], [0, 0, 1]];
+    let mut cosets = Vec::new();
+    for c in 0..turns {
+        let k = (c * 6 / turns) as usize;
+        let linear = [
+            [cos[k], -sin[k], 0.0],
+            [sin[k], cos[k], 0.0],
+            [0.0, 0.0, 1.0],
+        ];
+        cosets.push((r, [0, 0, c], linear));
+        r = mat_mul(&r, &step);
+    }
+    FlatManifold::in_lattice_frame(name, rows, gram, turns, &cosets, 2)
+}
 
 const I: [[i8; 3]; 3] = [[1, 0, 0], [0, 1, 0], [0, 0, 1]];
 
@@ -38,10 +82,12 @@ fn diag(a: i8, b: i8, c: i8) -> [[i8; 3]; 3] {
 
 impl FlatManifold<3> {
     /// The names [`Self::platycosm`] takes.
-    pub const PLATYCOSMS: [&'static str; 8] = [
+    pub const PLATYCOSMS: [&'static str; 10] = [
         "torocosm",
         "dicosm",
+        "tricosm",
         "tetracosm",
+        "hexacosm",
         "didicosm",
         "first-amphicosm",
         "second-amphicosm",
@@ -164,13 +210,20 @@ impl FlatManifold<3> {
                     0,
                 )
             }
-            "tricosm" | "hexacosm" => Err(Error::InvalidBox(format!(
-                "the {name} turns a hexagonal cross-section by a {} of a turn, which is \
-                 irrational in Cartesian coordinates; its exact predicates (in lattice \
-                 coordinates with an exact Gram matrix) are not in this version: one of {}",
-                if name == "tricosm" { "third" } else { "sixth" },
-                Self::PLATYCOSMS.join(", ")
-            ))),
+            "tricosm" | "hexacosm" => {
+                if l1 != l2 {
+                    return Err(Error::InvalidBox(format!(
+                        "the {name} turns a hexagonal cross-section of side L1: L1 = L2 needed, got {l1} and {l2}"
+                    )));
+                }
+                let turns = if name == "tricosm" { 3 } else { 6 };
+                hexagonal_screw(
+                    if turns == 3 { "tricosm" } else { "hexacosm" },
+                    l1,
+                    l3,
+                    turns,
+                )
+            }
             _ => Err(Error::InvalidBox(format!(
                 "unknown flat 3-manifold {name:?}: one of {}",
                 Self::PLATYCOSMS.join(", ")

@@ -62,6 +62,11 @@ pub struct Manifold<const D: usize> {
     pub volume: f64,
     /// Euler characteristic the quotient must have (0 for every closed flat manifold).
     pub euler: i64,
+    /// The metric: a vector `x` has squared length `Σ w_i x_i²`. Exact doubles, each at least
+    /// 1 (so Euclidean balls contain metric balls of the same radius); all 1 in Cartesian
+    /// coordinates. Other weights let a space with irrational rotations (a hexagonal
+    /// cross-section) be checked in coordinates where its group is rational.
+    pub metric: [f64; D],
 }
 
 impl<const D: usize> Manifold<D> {
@@ -75,6 +80,7 @@ impl<const D: usize> Manifold<D> {
             generators: rows.iter().map(|&r| Isometry::translation(r)).collect(),
             volume: f(&det(&m).abs()),
             euler: 0,
+            metric: [1.0; D],
         }
     }
 }
@@ -142,6 +148,31 @@ where
     std::array::from_fn(|i| &a[i] - &b[i])
 }
 
+/// `M⁻¹ = adj(M)/det(M)`: `(M⁻¹)_ij = cofactor_ji / det`.
+fn inverse_matrix<const D: usize>(m: &[[Q; D]; D]) -> [[Q; D]; D] {
+    let rows: Vec<Vec<Q>> = m.iter().map(|r| r.to_vec()).collect();
+    let d = det(&rows);
+    std::array::from_fn(|i| {
+        std::array::from_fn(|j| {
+            let minor: Vec<Vec<Q>> = (0..D)
+                .filter(|&r| r != j)
+                .map(|r| {
+                    (0..D)
+                        .filter(|&c| c != i)
+                        .map(|c| rows[r][c].clone())
+                        .collect()
+                })
+                .collect();
+            let c = det(&minor) / &d;
+            if (i + j) % 2 == 0 {
+                c
+            } else {
+                -c
+            }
+        })
+    })
+}
+
 fn approx<const D: usize>(x: &[Q; D]) -> [f64; D] {
     std::array::from_fn(|i| f(&x[i]))
 }
@@ -167,8 +198,9 @@ impl<const D: usize> Element<D> {
         }
     }
 
-    /// The exact element of an isometry: finite entries and an orthogonal linear part.
-    pub fn from_isometry(g: &Isometry<D>) -> Result<Self, String> {
+    /// The exact element of an isometry of the metric `w` (diagonal weights): finite entries
+    /// and a linear part with `Aᵀ·W·A = W`.
+    pub fn from_isometry(g: &Isometry<D>, w: &[Q; D]) -> Result<Self, String> {
         let mut a: [[Q; D]; D] = std::array::from_fn(|_| std::array::from_fn(|_| Q::zero()));
         for i in 0..D {
             for j in 0..D {
@@ -182,8 +214,8 @@ impl<const D: usize> Element<D> {
         let e = Element { a, t };
         for i in 0..D {
             for j in 0..D {
-                let s: Q = (0..D).map(|k| &e.a[k][i] * &e.a[k][j]).sum();
-                if s != if i == j { Q::one() } else { Q::zero() } {
+                let s: Q = (0..D).map(|k| &e.a[k][i] * &w[k] * &e.a[k][j]).sum();
+                if s != if i == j { w[i].clone() } else { Q::zero() } {
                     return Err(format!("{g:?} is not an isometry (A is not orthogonal)"));
                 }
             }
@@ -205,7 +237,8 @@ impl<const D: usize> Element<D> {
 
     /// The inverse (`A⁻¹ = Aᵀ`, orthogonal).
     pub fn inverse(&self) -> Self {
-        let a: [[Q; D]; D] = std::array::from_fn(|i| std::array::from_fn(|j| self.a[j][i].clone()));
+        // not Aᵀ: A is orthogonal for the metric, which need not be Euclidean
+        let a = inverse_matrix(&self.a);
         let t = std::array::from_fn(|i| -(0..D).map(|k| &a[i][k] * &self.t[k]).sum::<Q>());
         Element { a, t }
     }
@@ -263,12 +296,12 @@ const MAX_POINT_GROUP: usize = 1000;
 const MAX_ENUMERATED: usize = 20_000_000;
 
 impl<const D: usize> Group<D> {
-    /// Errs if a generator is not an isometry, the linear parts generate an infinite group, or
+    /// Errs if a generator is not an isometry of the metric `w`, the linear parts generate an infinite group, or
     /// the translations do not span `E^D` (the quotient would not be compact).
-    pub fn new(generators: &[Isometry<D>]) -> Result<Self, String> {
+    pub fn new(generators: &[Isometry<D>], w: &[Q; D]) -> Result<Self, String> {
         let gens: Vec<Element<D>> = generators
             .iter()
-            .map(Element::from_isometry)
+            .map(|g| Element::from_isometry(g, w))
             .collect::<Result<_, _>>()?;
         // the point group by closure (a finite monoid of invertible elements is a group)
         let mut cosets = vec![Element::identity()];
@@ -303,26 +336,7 @@ impl<const D: usize> Group<D> {
         size_reduce(&mut basis);
         let m: Vec<Vec<Q>> = basis.iter().map(|r| r.to_vec()).collect();
         let d = det(&m);
-        let inv = std::array::from_fn(|i| {
-            std::array::from_fn(|j| {
-                // (M⁻¹)_ij = cofactor_ji / det
-                let minor: Vec<Vec<Q>> = (0..D)
-                    .filter(|&r| r != j)
-                    .map(|r| {
-                        (0..D)
-                            .filter(|&c| c != i)
-                            .map(|c| m[r][c].clone())
-                            .collect()
-                    })
-                    .collect();
-                let c = det(&minor) / &d;
-                if (i + j) % 2 == 0 {
-                    c
-                } else {
-                    -c
-                }
-            })
-        });
+        let inv = inverse_matrix(&basis);
         let covolume = d.abs() / Q::from_integer(BigInt::from(cosets.len()));
         Ok(Group {
             cosets,
@@ -347,7 +361,8 @@ impl<const D: usize> Group<D> {
         })
     }
 
-    /// Every element `h` with `|h·c − c| ≤ bound`, exactly (`c` and `bound` as given).
+    /// Every element `h` with `|h·c − c| ≤ bound` in Euclidean length, exactly (`c` and
+    /// `bound` as given): a superset of the metric ball when the weights are at least 1.
     pub fn elements_near(&self, c: [f64; D], bound: f64) -> Result<Vec<Element<D>>, String> {
         let cq: [Q; D] = c.map(q);
         let b2 = q(bound) * q(bound);
@@ -703,10 +718,12 @@ struct Lifted<const D: usize, const N: usize> {
 }
 
 impl<const D: usize, const N: usize> Lifted<D, N> {
-    /// Whether `q` is strictly inside the circumsphere: `|q − x0|² − 2(q − x0)·y < 0`.
-    fn inside(&self, q: &[Z; D]) -> bool {
+    /// Whether `q` is strictly inside the circumsphere: `|q − x0|² − 2(q − x0)·y < 0` in
+    /// the metric of integer weights `w`.
+    fn inside(&self, q: &[Z; D], w: &[Z; D]) -> bool {
         let d = sub(q, &self.x[0]);
-        let s = dot(&d, &d) * &self.yd - Z::from(2) * dot(&d, &self.yn);
+        let wd: [Z; D] = std::array::from_fn(|i| &w[i] * &d[i]);
+        let s = dot(&wd, &d) * &self.yd - Z::from(2) * dot(&wd, &self.yn);
         s.sign() == -self.yd.sign()
     }
 }
@@ -737,7 +754,23 @@ pub fn check<const D: usize, const N: usize>(
     cells: &[([u32; N], [Isometry<D>; N])],
 ) -> Result<(), String> {
     assert_eq!(N, D + 1, "cells of E^{D} have {} vertices", D + 1);
-    let group = Group::new(&m.generators)?;
+    if m.metric.iter().any(|&w| !(w >= 1.0 && w.is_finite())) {
+        return Err(format!(
+            "the metric {:?} needs weights of at least 1",
+            m.metric
+        ));
+    }
+    let wq: [Q; D] = m.metric.map(q);
+    // the same metric, scaled to integers (scaling changes no circumcenter and no sign)
+    let wden = lcm(wq.iter());
+    let wz: [Z; D] = wq.each_ref().map(|x| integral(x, &wden));
+    let norm_w = |x: &[f64; D]| {
+        (0..D)
+            .map(|i| m.metric[i] * x[i] * x[i])
+            .sum::<f64>()
+            .sqrt()
+    };
+    let group = Group::new(&m.generators, &wq)?;
     let given = exact(m.volume, &|| "the manifold's volume".into())?;
     if given != group.covolume {
         let r = relative(&given, &group.covolume);
@@ -802,7 +835,7 @@ pub fn check<const D: usize, const N: usize>(
             let e = match by_bits.get(&bits) {
                 Some(&e) => e,
                 None => {
-                    let g = Element::from_isometry(&gs[k])
+                    let g = Element::from_isometry(&gs[k], &wq)
                         .map_err(|s| format!("cell {c} {vs:?}, vertex {k}: {s}"))?;
                     if !group.contains(&g) {
                         return Err(format!(
@@ -822,7 +855,7 @@ pub fn check<const D: usize, const N: usize>(
 
     // per cell: orientation, circumsphere (in the frame of its vertex 0), volume
     let basis: Vec<[f64; D]> = group.lattice.iter().map(approx).collect();
-    let rho = 0.5 * basis.iter().map(|b| norm(b)).sum::<f64>();
+    let rho = 0.5 * basis.iter().map(norm_w).sum::<f64>();
     let mut total = Z::zero();
     let mut lifted: Vec<Lifted<D, N>> = Vec::with_capacity(cells.len());
     for (c, ids) in given_ids.iter().enumerate() {
@@ -844,19 +877,32 @@ pub fn check<const D: usize, const N: usize>(
             ));
         }
         total += vol.abs();
-        // circumcenter y − x0: 2 d_k·y = |d_k|², by Cramer's rule
-        let rhs: Vec<Z> = rows.iter().map(|r| r.iter().map(|v| v * v).sum()).collect();
+        // circumcenter y − x0: 2 d_k·W·y = d_k·W·d_k, by Cramer's rule
+        let weighted: Vec<Vec<Z>> = rows
+            .iter()
+            .map(|r| r.iter().zip(&wz).map(|(v, w)| v * w).collect())
+            .collect();
+        let rhs: Vec<Z> = rows
+            .iter()
+            .zip(&weighted)
+            .map(|(r, rw)| r.iter().zip(rw).map(|(v, vw)| v * vw).sum())
+            .collect();
         let yn: [Z; D] = std::array::from_fn(|i| {
-            let mut mi = rows.clone();
+            let mut mi = weighted.clone();
             for k in 0..D {
                 mi[k][i] = rhs[k].clone();
             }
             det(&mi)
         });
-        let yd = Z::from(2) * vol;
+        let yd = Z::from(2) * det(&weighted);
         let to_user = |z: &Z| Q::new(z.clone(), &yd * &scale.l);
         let center = std::array::from_fn(|i| f(&(&pq[v[0].0 as usize][i] + to_user(&yn[i]))));
-        let radius = f(&Q::new(dot(&yn, &yn), &yd * &yd * &scale.l * &scale.l)).sqrt();
+        let ynw: [Z; D] = std::array::from_fn(|i| &yn[i] * &wz[i]);
+        let radius = f(&Q::new(
+            dot(&ynw, &yn),
+            &yd * &yd * &scale.l * &scale.l * &wden,
+        ))
+        .sqrt();
         lifted.push(Lifted {
             v,
             x,
@@ -886,7 +932,7 @@ pub fn check<const D: usize, const N: usize>(
                 "cell {c} {:?}: circumradius {} exceeds the covering radius bound {rho}{}",
                 cells[c].0,
                 l.radius,
-                if l.inside(&image) {
+                if l.inside(&image, &wz) {
                     format!(
                         "; point {}'s image by translation {:?} is inside",
                         l.v[0].0,
@@ -912,14 +958,15 @@ pub fn check<const D: usize, const N: usize>(
     let hi: [f64; D] =
         std::array::from_fn(|i| points.iter().map(|p| p[i]).fold(f64::MIN, f64::max));
     let c0: [f64; D] = std::array::from_fn(|i| 0.5 * lo[i] + 0.5 * hi[i]);
-    let dist =
-        |a: &[f64; D], b: &[f64; D]| norm(&std::array::from_fn::<f64, D, _>(|i| a[i] - b[i]));
+    // distances in the metric (the bound below rests on the group's isometries); Euclidean
+    // distances are at most these, so the Euclidean filters further down only widen
+    let dist = |a: &[f64; D], b: &[f64; D]| norm_w(&std::array::from_fn(|i| a[i] - b[i]));
     let rp = points.iter().map(|p| dist(p, &c0)).fold(0.0, f64::max);
     let reach = lifted
         .iter()
         .map(|l| dist(&l.center, &c0) + l.radius)
         .fold(rp, f64::max);
-    let delta = 1e-9 * (norm(&c0) + rp + reach + rho);
+    let delta = 1e-9 * (norm_w(&c0) + rp + reach + rho);
     let bound = (reach + rp) * (1.0 + 1e-6) + delta;
     let elements = group.elements_near(c0, bound)?;
     if elements.len() * points.len() > MAX_ENUMERATED {
@@ -979,7 +1026,7 @@ pub fn check<const D: usize, const N: usize>(
                 continue;
             }
             let (i, e) = image_of[k as usize];
-            if l.inside(&lifts.get(&el, i, e)) {
+            if l.inside(&lifts.get(&el, i, e), &wz) {
                 return Err(format!(
                     "cell {c} {:?}: point {i}'s image by {:?} is strictly inside its circumsphere",
                     cells[c].0,
