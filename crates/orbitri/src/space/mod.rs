@@ -144,12 +144,15 @@ pub trait OrbitSpace<const N: usize>: Sync + Send {
 /// A flat orbit space as the facade, the Voronoi layer and the writers see it: points
 /// `[f64; D]` in the user's units outside, in the space's internal frame (a power-of-two
 /// scaling, see [`Lattice`]) inside, each stored at a canonical representative in the
-/// fundamental domain.
+/// fundamental domain. A stored point may be in coordinates of the space's own (lattice
+/// coordinates for the hexagonal screws): its position is always `lifted_position` of it
+/// with the identity, and constructions (positions, differences, circumcenters) are
+/// Cartesian in the internal frame.
 pub trait FlatSpace<const D: usize, const N: usize>:
     OrbitSpace<N, Point = [f64; D]> + Clone
 {
-    /// The representative of a user point in the fundamental domain, in the internal frame,
-    /// and whether it moved; `None` when it lies too far away to be wrapped exactly.
+    /// The stored representative of a user point in the fundamental domain, and whether it
+    /// moved; `None` when it lies too far away to be wrapped exactly.
     fn canonical_point(&self, x: &[f64; D]) -> Option<([f64; D], bool)>;
     /// An internal point in user units (exact).
     fn to_user(&self, x: [f64; D]) -> [f64; D];
@@ -167,7 +170,7 @@ pub trait FlatSpace<const D: usize, const N: usize>:
     /// A vector in the frame of `g` seen from the frame of the identity: `A⁻¹·v` for
     /// `g: x ↦ A·x + t` (`v` itself for a translation).
     fn untwist(&self, g: Self::Elem, v: [f64; D]) -> [f64; D];
-    /// The element `g` with `g·from = to` exactly, when `from` and `to` (internal frame) are
+    /// The element `g` with `g·from = to` exactly, when `from` and `to` (stored points) are
     /// two representatives of one point of the space.
     fn relating(&self, from: [f64; D], to: [f64; D]) -> Option<Self::Elem>;
     /// A face given by (vertex, element) pairs in canonical form modulo the group: two
