@@ -276,7 +276,7 @@ fn insert_all<const D: usize, const N: usize, S: Served<D, N>>(
         .into_iter()
         .map(|r| {
             let (orbitri::Inserted::New(v) | orbitri::Inserted::Duplicate(v)) = r;
-            i64::from(t.input_of_vertex(v))
+            i64::from(t.input_of_vertex(v.0))
         })
         .collect())
 }

@@ -9,8 +9,11 @@ use std::ops::ControlFlow;
 
 use crate::delaunay::{Engine, Inserted, Invalid};
 use crate::error::{Error, Result};
+use crate::ids::{CellId, PointId, VertexId};
 use crate::space::{FlatManifold, FlatSpace, FlatTorus, OrbitSpace};
-use crate::tds::NONE;
+
+/// Marks an unset entry of the input ↔ point maps.
+const NONE: u32 = u32::MAX;
 
 /// Offset of a vertex in lattice-vector units.
 pub type Offset<const D: usize = 3> = [i8; D];
@@ -272,7 +275,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         let g = self.space().relating(want, have);
         debug_assert!(g.is_some(), "a duplicate is an exact image");
         if let Some(g) = g {
-            self.engine.move_representative(p, want, g);
+            self.engine.move_representative(PointId(p), want, g);
         }
     }
 
@@ -298,15 +301,16 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             }
             match self.engine.insert(pts[i as usize]) {
                 Inserted::New(p) => {
-                    self.input_point[i as usize] = p;
+                    self.input_point[i as usize] = p.0;
                     self.point_input.push(i);
                 }
-                Inserted::Duplicate(p) if p < k => return Ok(false),
-                Inserted::Duplicate(p) => self.record_duplicate(i as usize, p),
+                Inserted::Duplicate(p) if p.0 < k => return Ok(false),
+                Inserted::Duplicate(p) => self.record_duplicate(i as usize, p.0),
             }
         }
+        // 1-sheeted: the vertex of dummy point `d` has its id
         for d in 0..k {
-            if self.engine.remove_vertex(d).is_err() {
+            if self.engine.remove_vertex(VertexId(d)).is_err() {
                 return Ok(false);
             }
         }
@@ -324,10 +328,10 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         let r = self.engine.insert(p);
         match r {
             Inserted::New(v) => {
-                self.input_point[i] = v;
+                self.input_point[i] = v.0;
                 self.point_input.push(i as u32);
             }
-            Inserted::Duplicate(v) => self.record_duplicate(i, v),
+            Inserted::Duplicate(v) => self.record_duplicate(i, v.0),
         }
         r
     }
@@ -364,15 +368,15 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         self.input_point.resize(first + points.len(), NONE);
         self.wrapped += moved;
         let seed = BuildOptions::default().seed ^ first as u64;
-        let mut out = vec![Inserted::New(0); points.len()];
+        let mut out = vec![Inserted::New(PointId(0)); points.len()];
         for k in spatial_order(self.space(), &internal, seed) {
             out[k as usize] = self.insert_wrapped(first + k as usize, internal[k as usize]);
         }
         // a duplicate inserted before its first occurrence lent the point its coordinates
         for (k, r) in out.iter().enumerate() {
             let (Inserted::New(p) | Inserted::Duplicate(p)) = *r;
-            if self.point_input[p as usize] as usize == first + k {
-                self.represent(p, internal[k]);
+            if self.point_input[p.index()] as usize == first + k {
+                self.represent(p.0, internal[k]);
             }
         }
         Ok(out)
@@ -476,12 +480,15 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             .collect()
     }
 
-    fn view(&self, c: u32) -> CellView<D, N, S::Elem> {
+    /// The input id of a stored vertex's point.
+    fn input_of(&self, v: VertexId) -> u32 {
+        self.point_input[self.engine.point_of(v).index()]
+    }
+
+    fn view(&self, c: CellId) -> CellView<D, N, S::Elem> {
         let cell = self.engine.cell(c);
         CellView {
-            vertices: cell
-                .v
-                .map(|x| self.point_input[self.engine.point_of(x) as usize]),
+            vertices: cell.v.map(|x| self.input_of(x)),
             offsets: cell.off,
         }
     }
@@ -494,16 +501,16 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     /// Every stored cell (as `stored_cells`) with its neighbours: `neighbors[k][i]` is the
     /// position in this list of the cell opposite vertex `i` of cell `k`.
     pub fn cells_with_neighbors(&self) -> (Vec<CellView<D, N, S::Elem>>, Vec<[u32; N]>) {
-        let ids: Vec<u32> = self.engine.cell_ids().collect();
-        let slots = ids.iter().max().map_or(0, |&m| m as usize + 1);
+        let ids: Vec<CellId> = self.engine.cell_ids().collect();
+        let slots = ids.iter().max().map_or(0, |m| m.index() + 1);
         let mut position = vec![u32::MAX; slots];
         for (k, &c) in ids.iter().enumerate() {
-            position[c as usize] = k as u32;
+            position[c.index()] = k as u32;
         }
         let views = ids.iter().map(|&c| self.view(c)).collect();
         let neighbors = ids
             .iter()
-            .map(|&c| self.engine.cell(c).n.map(|d| position[d as usize]))
+            .map(|&c| self.engine.cell(c).n.map(|d| position[d.index()]))
             .collect();
         (views, neighbors)
     }
@@ -521,11 +528,11 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
 
     /// A face of a stored cell (the slots in `idx`): its vertices as input ids (`Unique`)
     /// or stored vertex ids (`Stored`), in canonical form.
-    fn face(&self, c: u32, idx: &[usize], copies: Copies) -> Simplex<D, S::Elem> {
+    fn face(&self, c: CellId, idx: &[usize], copies: Copies) -> Simplex<D, S::Elem> {
         let cell = self.engine.cell(c);
-        let id = |x: u32| match copies {
-            Copies::Unique => self.point_input[self.engine.point_of(x) as usize],
-            Copies::Stored => x,
+        let id = |x: VertexId| match copies {
+            Copies::Unique => self.input_of(x),
+            Copies::Stored => x.0,
         };
         let v: Vec<u32> = idx.iter().map(|&i| id(cell.v[i])).collect();
         let o: Vec<S::Elem> = idx.iter().map(|&i| cell.off[i]).collect();
@@ -546,24 +553,26 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     /// The edges (input ids, offsets), each once; `Stored` lists covering copies by vertex
     /// id. Found from each vertex's neighbours, towards the larger vertex id.
     pub fn edges(&self, copies: Copies) -> Vec<Simplex<D, S::Elem>> {
-        let id = move |x: u32| match copies {
-            Copies::Unique => self.point_input[self.engine.point_of(x) as usize],
-            Copies::Stored => x,
+        let id = move |x: VertexId| match copies {
+            Copies::Unique => self.input_of(x),
+            Copies::Stored => x.0,
         };
-        let all = (0..self.engine.number_of_vertices() as u32).flat_map(move |v| {
-            self.engine
-                .neighbours(v)
-                .into_iter()
-                .filter(move |w| w.0 > v)
-                .map(move |(w, rel)| {
-                    let (vertices, offsets) = canonical(
-                        self.space(),
-                        &[id(v), id(w)],
-                        &[self.space().identity(), rel],
-                    );
-                    Simplex { vertices, offsets }
-                })
-        });
+        let all = (0..self.engine.number_of_vertices() as u32)
+            .map(VertexId)
+            .flat_map(move |v| {
+                self.engine
+                    .neighbours(v)
+                    .into_iter()
+                    .filter(move |w| w.0 > v)
+                    .map(move |(w, rel)| {
+                        let (vertices, offsets) = canonical(
+                            self.space(),
+                            &[id(v), id(w)],
+                            &[self.space().identity(), rel],
+                        );
+                        Simplex { vertices, offsets }
+                    })
+            });
         if copies == Copies::Unique && !self.is_one_sheeted() {
             return self.unique_in_covering(all);
         }
@@ -600,7 +609,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             let n = self.engine.cell(c).n;
             (0..N).filter(move |&i| c < n[i]).map(move |i| (c, i))
         });
-        let face = |(c, i): (u32, usize)| {
+        let face = |(c, i): (CellId, usize)| {
             let idx: Vec<usize> = (0..N).filter(|&k| k != i).collect();
             self.face(c, &idx, copies)
         };
@@ -613,12 +622,12 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     /// The neighbours of input point `i`: (input id, offset of the neighbour relative to
     /// the point), one entry per Delaunay edge at the point, from the point's star.
     pub fn vertex_neighbors(&self, i: usize) -> Vec<(u32, S::Elem)> {
-        let v = self.engine.vertex_of_point(self.input_point[i]);
+        let v = self.engine.vertex_of_point(PointId(self.input_point[i]));
         let mut out: Vec<(u32, S::Elem)> = self
             .engine
             .neighbours(v)
             .into_iter()
-            .map(|(w, rel)| (self.point_input[self.engine.point_of(w) as usize], rel))
+            .map(|(w, rel)| (self.input_of(w), rel))
             .collect();
         out.sort_unstable();
         out

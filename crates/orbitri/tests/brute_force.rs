@@ -4,7 +4,7 @@
 mod common;
 use common::*;
 use orbitri::sort::SplitMix;
-use orbitri::{BuildOptions, Copies, FlatTorus3, Inserted, PeriodicDelaunay3};
+use orbitri::{BuildOptions, Copies, FlatTorus3, Inserted, PeriodicDelaunay3, PointId};
 
 fn build(space: FlatTorus3, pts: &[[f64; 3]], opts: BuildOptions) -> PeriodicDelaunay3 {
     let tri =
@@ -199,12 +199,13 @@ fn incremental_insertion_matches_bulk() {
     let pts = uniform(700, 8, [1.0; 3]);
     let mut inc = PeriodicDelaunay3::new(FlatTorus3::cuboid([1.0; 3]).unwrap());
     for (i, p) in pts.iter().enumerate() {
-        assert_eq!(inc.insert(*p).unwrap(), Inserted::New(i as u32));
+        // inserted one by one, a point's id is its input id
+        assert_eq!(inc.insert(*p).unwrap(), Inserted::New(PointId::new(i)));
         if i < 4 {
             assert_eq!(inc.sheets(), 27);
         }
     }
-    assert_eq!(inc.insert(pts[3]).unwrap(), Inserted::Duplicate(3));
+    assert_eq!(inc.insert(pts[3]).unwrap(), Inserted::Duplicate(PointId(3)));
     inc.is_valid().unwrap();
     let bulk = build(
         FlatTorus3::cuboid([1.0; 3]).unwrap(),

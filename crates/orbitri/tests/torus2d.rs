@@ -9,6 +9,7 @@ use orbitri::sort::SplitMix;
 use orbitri::space::{FlatTorus, Ladder, Lattice};
 use orbitri::{
     BuildOptions, CellView, Copies, Engine, FlatTorus2, Inserted, OrbitSpace, PeriodicDelaunay2,
+    PointId,
 };
 
 fn data(name: &str) -> String {
@@ -425,8 +426,11 @@ fn duplicates_and_wrapping_lose_nothing_in_2d() {
     assert_eq!(&firsts[..6], &[0, 0, 2, 2, 4, 0]);
     brute_force(&tri);
     let mut inc = PeriodicDelaunay2::new(torus);
-    assert_eq!(inc.insert([0.5, 0.5]).unwrap(), Inserted::New(0));
-    assert_eq!(inc.insert([2.5, -0.5]).unwrap(), Inserted::Duplicate(0));
+    assert_eq!(inc.insert([0.5, 0.5]).unwrap(), Inserted::New(PointId(0)));
+    assert_eq!(
+        inc.insert([2.5, -0.5]).unwrap(),
+        Inserted::Duplicate(PointId(0))
+    );
 }
 
 #[test]
