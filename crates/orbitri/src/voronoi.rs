@@ -11,7 +11,7 @@
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
-use crate::ids::{CellId, PointId, VertexId};
+use crate::ids::{CellId, InputId, PointId, VertexId};
 use crate::space::FlatSpace;
 use crate::triangulation::Triangulation;
 
@@ -22,7 +22,7 @@ pub struct VoronoiFace<const D: usize, E = [i8; D]> {
     /// the cell; in 2D the two ends of the edge.
     pub vertices: Vec<u32>,
     /// Input id of the neighbour (its first occurrence).
-    pub neighbor: u32,
+    pub neighbor: InputId,
     /// The neighbour's image across this face is `shift·points[neighbor]` (in a torus
     /// `points[neighbor] + shift·M`).
     pub shift: E,
@@ -35,7 +35,7 @@ pub struct VoronoiFace<const D: usize, E = [i8; D]> {
 #[derive(Clone, Debug, PartialEq)]
 pub struct VoronoiCell<const D: usize, E = [i8; D]> {
     /// Input id of the point (its first occurrence).
-    pub point: u32,
+    pub point: InputId,
     /// The point's wrapped position.
     pub position: [f64; D],
     pub vertices: Vec<[f64; D]>,
@@ -49,7 +49,7 @@ pub struct VoronoiCell<const D: usize, E = [i8; D]> {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CellMeasures<const D: usize> {
     /// Input id of the point (its first occurrence).
-    pub point: u32,
+    pub point: InputId,
     /// Volume (area in 2D).
     pub volume: f64,
     /// Number of faces (of neighbours, counting each image).
@@ -75,8 +75,8 @@ impl<const D: usize, E> From<&VoronoiCell<D, E>> for CellMeasures<D> {
 /// shares a face of this area with `i`. Each unordered pair of images is listed once.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Neighbor<const D: usize, E = [i8; D]> {
-    pub i: u32,
-    pub j: u32,
+    pub i: InputId,
+    pub j: InputId,
     pub shift: E,
     pub area: f64,
 }
@@ -133,9 +133,9 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     /// The Voronoi cell of input point `i` (a duplicate gets its first occurrence's cell).
     /// It computes the circumcenters and cospherical classes of the whole triangulation
     /// first: for many cells, call [`Self::voronoi_cells`] once.
-    pub fn voronoi_cell(&self, i: usize) -> VoronoiCell<D, S::Elem> {
+    pub fn voronoi_cell(&self, i: InputId) -> VoronoiCell<D, S::Elem> {
         let duals = self.duals(&|| false).expect("never interrupted");
-        self.cell_of_point(&duals, PointId(self.vertex_of_input(i)))
+        self.cell_of_point(&duals, self.vertex_of_input(i))
     }
 
     /// The Voronoi cells of the distinct points, in the order of their first occurrence
@@ -209,7 +209,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             })
             .collect::<Result<_>>()?;
         let mut order: Vec<PointId> = (0..out.len() as u32).map(PointId).collect();
-        order.sort_unstable_by_key(|&p| self.input_of_vertex(p.0));
+        order.sort_unstable_by_key(|&p| self.input_of_vertex(p));
         Ok(order
             .iter()
             .map(|&p| out[p.index()].take().expect("each point once"))
@@ -397,7 +397,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             };
             faces.push(VoronoiFace {
                 vertices: ids,
-                neighbor: self.input_of_vertex(e.point_of(w).0),
+                neighbor: self.input_of_vertex(e.point_of(w)),
                 shift: r,
                 area,
             });
@@ -412,7 +412,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         }
         let around = |x: &[f64; D]| space.to_user(std::array::from_fn(|c| position[c] + x[c]));
         VoronoiCell {
-            point: self.input_of_vertex(p.0),
+            point: self.input_of_vertex(p),
             position: space.to_user(position),
             vertices: vertices.iter().map(around).collect(),
             faces,
