@@ -558,8 +558,7 @@ fn demo(n: usize, seed: u64) -> Result<(), CliError> {
         format!(
             "  {:.2} µs per point; Euler check E = V + C: {}",
             cost.seconds * 1e6 / n as f64,
-            tri.edges(orbitri::Copies::Unique).len()
-                == tri.number_of_vertices() + tri.number_of_cells()
+            tri.edges().len() == tri.number_of_vertices() + tri.number_of_cells()
         ),
     );
     let t = Instant::now();

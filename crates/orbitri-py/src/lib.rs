@@ -25,7 +25,7 @@ use std::time::Duration;
 use numpy::ndarray::{Array1, Array2, Array3, ArrayD, ArrayView2, IxDyn};
 use numpy::{AllowTypeChange, IntoPyArray, PyArray1, PyArray2, PyArrayLike1, PyArrayLike2};
 use orbitri::{
-    BuildOptions, CellMeasures, FlatManifold, FlatSpace, FlatTorus, Motion, OrbitSpace,
+    BuildOptions, CellMeasures, FlatManifold, FlatSpace, FlatTorus, InputId, Motion, OrbitSpace,
     Triangulation as Tri_, VoronoiCell,
 };
 use pyo3::exceptions::{PyIndexError, PyOverflowError, PyRuntimeError, PyValueError};
@@ -276,7 +276,7 @@ fn insert_all<const D: usize, const N: usize, S: Served<D, N>>(
         .into_iter()
         .map(|r| {
             let (orbitri::Inserted::New(v) | orbitri::Inserted::Duplicate(v)) = r;
-            i64::from(t.input_of_vertex(v))
+            i64::from(t.input_of_vertex(v).0)
         })
         .collect())
 }
@@ -323,7 +323,7 @@ fn simplices<const D: usize, const N: usize, S: Served<D, N>>(
     let c = cells.len();
     let v: Vec<i64> = cells
         .iter()
-        .flat_map(|x| x.vertices.map(i64::from))
+        .flat_map(|x| x.vertices.map(|v| i64::from(v.0)))
         .collect();
     let n: Vec<i64> = nbrs.iter().flat_map(|x| x.map(i64::from)).collect();
     (
@@ -350,7 +350,7 @@ fn locate<const D: usize, const N: usize, S: Served<D, N>>(
         .map_err(value_error)?;
     Ok((
         cell.vertices
-            .map(i64::from)
+            .map(|v| i64::from(v.0))
             .to_vec()
             .into_pyarray(py)
             .into_any()
@@ -368,7 +368,7 @@ fn edges<const D: usize, const N: usize, S: Served<D, N>>(
     let e = t.delaunay_edges();
     let ij: Vec<i64> = e
         .iter()
-        .flat_map(|x| [i64::from(x.i), i64::from(x.j)])
+        .flat_map(|x| [i64::from(x.i.0), i64::from(x.j.0)])
         .collect();
     let l: Vec<f64> = e.iter().map(|x| x.length).collect();
     (
@@ -384,8 +384,8 @@ fn vertex_neighbors<const D: usize, const N: usize, S: Served<D, N>>(
     t: &Tri_<D, N, S>,
     i: usize,
 ) -> (Py<PyAny>, Py<PyAny>) {
-    let nb = t.vertex_neighbors(i);
-    let ids: Vec<i64> = nb.iter().map(|x| i64::from(x.0)).collect();
+    let nb = t.vertex_neighbors(InputId::new(i));
+    let ids: Vec<i64> = nb.iter().map(|x| i64::from(x.0 .0)).collect();
     (
         ids.into_pyarray(py).into_any().unbind(),
         py_elements::<D, N, S>(py, &[nb.len()], nb.iter().map(|x| x.1)),
@@ -485,7 +485,7 @@ impl Triangulation {
         Ok(with_tri!(&*self.read(py)?, t => {
             let n = t.number_of_input_points();
             let v: Vec<f64> = (0..n)
-                .flat_map(|i| t.point(t.vertex_of_input(i)))
+                .flat_map(|i| t.point(t.vertex_of_input(InputId::new(i))))
                 .collect();
             array2(py, n, d, v)
         }))
@@ -536,7 +536,7 @@ impl Triangulation {
         let first = with_tri!(&*self.read(py)?, t => t.first_occurrences());
         Ok(first
             .into_iter()
-            .map(i64::from)
+            .map(|f| i64::from(f.0))
             .collect::<Array1<i64>>()
             .into_pyarray(py))
     }
@@ -646,7 +646,7 @@ impl Triangulation {
 /// occurrence, and the space (for the elements' inverses).
 struct CellsOf<const D: usize, const N: usize, S: Served<D, N>> {
     cells: Vec<VoronoiCell<D, S::Elem>>,
-    first: Vec<u32>,
+    first: Vec<InputId>,
     space: S,
 }
 
@@ -678,7 +678,7 @@ impl<const D: usize, const N: usize, S: Served<D, N>> CellsOf<D, N, S> {
         });
         let ij: Vec<i64> = pairs
             .iter()
-            .flat_map(|p| [i64::from(p.i), i64::from(p.j)])
+            .flat_map(|p| [i64::from(p.i.0), i64::from(p.j.0)])
             .collect();
         let a: Vec<f64> = pairs.iter().map(|p| p.area).collect();
         (
@@ -694,7 +694,7 @@ impl<const D: usize, const N: usize, S: Served<D, N>> CellsOf<D, N, S> {
             .iter()
             .map(|cell| {
                 let d = PyDict::new(py);
-                d.set_item("id", cell.point)?;
+                d.set_item("id", cell.point.0)?;
                 d.set_item("position", cell.position.to_vec())?;
                 d.set_item("volume", cell.volume)?;
                 d.set_item("centroid", cell.centroid.to_vec())?;
@@ -706,7 +706,7 @@ impl<const D: usize, const N: usize, S: Served<D, N>> CellsOf<D, N, S> {
                     .map(|f| {
                         let fd = PyDict::new(py);
                         fd.set_item("vertices", f.vertices.clone())?;
-                        fd.set_item("neighbor", f.neighbor)?;
+                        fd.set_item("neighbor", f.neighbor.0)?;
                         let offset = f.shift.offset().to_vec();
                         match S::COSETS {
                             true => fd.set_item("element", (f.shift.coset(), offset))?,

@@ -27,6 +27,7 @@
 
 pub mod delaunay;
 pub mod error;
+pub mod ids;
 pub mod io;
 pub mod predicates;
 pub mod sort;
@@ -37,6 +38,7 @@ pub mod voronoi;
 
 pub use delaunay::{Engine, Inserted, Invalid};
 pub use error::{Error, Result};
+pub use ids::{CellId, InputId, PointId, VertexId};
 pub use space::{
     Coset, FlatManifold, FlatSpace, FlatTorus, FlatTorus2, FlatTorus3, Ladder, Lattice, Motion,
     OrbitSpace,

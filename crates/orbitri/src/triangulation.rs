@@ -9,8 +9,8 @@ use std::ops::ControlFlow;
 
 use crate::delaunay::{Engine, Inserted, Invalid};
 use crate::error::{Error, Result};
+use crate::ids::{CellId, InputId, PointId, VertexId};
 use crate::space::{FlatManifold, FlatSpace, FlatTorus, OrbitSpace};
-use crate::tds::NONE;
 
 /// Offset of a vertex in lattice-vector units.
 pub type Offset<const D: usize = 3> = [i8; D];
@@ -27,7 +27,9 @@ impl<const D: usize, const N: usize> Torus<D, N> for FlatTorus<D> where
 {
 }
 
-/// Which copies an iterator yields in a multi-sheeted covering (CGAL's iterator types).
+/// Which copies [`Triangulation::cells`] yields in a multi-sheeted covering (CGAL's iterator
+/// types). Edges and facets have a method for each instead ([`Triangulation::edges`],
+/// [`Triangulation::stored_edges`]), since their vertices are ids of different types.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Copies {
     /// One copy per simplex of the quotient.
@@ -41,16 +43,17 @@ pub enum Copies {
 /// (counter-clockwise in 2D).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct CellView<const D: usize = 3, const N: usize = 4, E = Offset<D>> {
-    pub vertices: [u32; N],
+    pub vertices: [InputId; N],
     pub offsets: [E; N],
 }
 
 /// A simplex of lower dimension (edge: 2 vertices, facet: `D`), canonical modulo the group:
 /// for a torus, sorted by (vertex, offset) with the componentwise minimum offset translated
-/// to zero.
+/// to zero. Its vertices are input ids ([`Triangulation::edges`]), or the stored vertices of
+/// a covering space (`I = VertexId`, [`Triangulation::stored_edges`]).
 #[derive(Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct Simplex<const D: usize = 3, E = Offset<D>> {
-    pub vertices: Vec<u32>,
+pub struct Simplex<const D: usize = 3, E = Offset<D>, I = InputId> {
+    pub vertices: Vec<I>,
     pub offsets: Vec<E>,
 }
 
@@ -58,8 +61,8 @@ pub struct Simplex<const D: usize = 3, E = Offset<D>> {
 /// joined to point `i`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DelaunayEdge<const D: usize, E = Offset<D>> {
-    pub i: u32,
-    pub j: u32,
+    pub i: InputId,
+    pub j: InputId,
     pub shift: E,
     pub length: f64,
 }
@@ -89,10 +92,10 @@ impl Default for BuildOptions {
 #[derive(Debug)]
 pub struct Triangulation<const D: usize, const N: usize, S: FlatSpace<D, N> = FlatTorus<D>> {
     engine: Engine<S, N>,
-    /// Input index → point (vertex) index.
-    input_point: Vec<u32>,
-    /// Point index → input index of its first occurrence.
-    point_input: Vec<u32>,
+    /// Input → its point (a vertex of the quotient).
+    input_point: Vec<PointId>,
+    /// Point → the input id of its first occurrence.
+    point_input: Vec<InputId>,
     wrapped: usize,
     duplicates: usize,
     used_dummies: bool,
@@ -237,12 +240,12 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         }
         let mut tri = Self::new(space);
         tri.wrapped = wrapped;
-        tri.input_point = vec![NONE; points.len()];
+        tri.input_point = vec![PointId::NONE; points.len()];
         for (k, &i) in order.iter().enumerate() {
             if k % 4096 == 0 {
                 proceed(&mut progress, k)?;
             }
-            tri.insert_wrapped(i as usize, wrapped_pts[i as usize]);
+            tri.insert_wrapped(InputId(i), wrapped_pts[i as usize]);
         }
         if !tri.engine.is_one_sheeted() {
             tri.engine.try_one_sheet();
@@ -258,14 +261,14 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     /// lattice translation, which the offsets of the point's star absorb.
     fn represent_first_occurrences(&mut self, wrapped: &[[f64; D]]) {
         for p in 0..self.point_input.len() {
-            self.represent(p as u32, wrapped[self.point_input[p] as usize]);
+            self.represent(PointId::new(p), wrapped[self.point_input[p].index()]);
         }
     }
 
     /// Gives point `p` the wrapped coordinates `want` of its first occurrence, when they
     /// differ from the current ones by an exact group element.
-    fn represent(&mut self, p: u32, want: [f64; D]) {
-        let have = self.engine.points()[p as usize];
+    fn represent(&mut self, p: PointId, want: [f64; D]) {
+        let have = self.engine.points()[p.index()];
         if want == have {
             return;
         }
@@ -289,9 +292,9 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         let k = dummies.len() as u32;
         self.engine.points = dummies;
         self.engine.bootstrap_one_sheeted();
-        self.input_point = vec![NONE; pts.len()];
-        // placeholders: point indices count the dummies until they are dropped
-        self.point_input = vec![NONE; k as usize];
+        self.input_point = vec![PointId::NONE; pts.len()];
+        // placeholders: point ids count the dummies until they are dropped
+        self.point_input = vec![InputId::NONE; k as usize];
         for (n, &i) in order.iter().enumerate() {
             if n % 4096 == 0 {
                 proceed(progress, n)?;
@@ -299,33 +302,34 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             match self.engine.insert(pts[i as usize]) {
                 Inserted::New(p) => {
                     self.input_point[i as usize] = p;
-                    self.point_input.push(i);
+                    self.point_input.push(InputId(i));
                 }
-                Inserted::Duplicate(p) if p < k => return Ok(false),
-                Inserted::Duplicate(p) => self.record_duplicate(i as usize, p),
+                Inserted::Duplicate(p) if p.0 < k => return Ok(false),
+                Inserted::Duplicate(p) => self.record_duplicate(InputId(i), p),
             }
         }
+        // 1-sheeted: the vertex of dummy point `d` has its id
         for d in 0..k {
-            if self.engine.remove_vertex(d).is_err() {
+            if self.engine.remove_vertex(VertexId(d)).is_err() {
                 return Ok(false);
             }
         }
         self.engine.drop_leading_points(k);
         self.point_input.drain(..k as usize);
         for p in self.input_point.iter_mut() {
-            *p -= k;
+            *p = PointId(p.0 - k);
         }
         self.used_dummies = true;
         proceed(progress, pts.len())?;
         Ok(true)
     }
 
-    fn insert_wrapped(&mut self, i: usize, p: [f64; D]) -> Inserted {
+    fn insert_wrapped(&mut self, i: InputId, p: [f64; D]) -> Inserted {
         let r = self.engine.insert(p);
         match r {
             Inserted::New(v) => {
-                self.input_point[i] = v;
-                self.point_input.push(i as u32);
+                self.input_point[i.index()] = v;
+                self.point_input.push(i);
             }
             Inserted::Duplicate(v) => self.record_duplicate(i, v),
         }
@@ -333,21 +337,22 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     }
 
     /// Input `i` coincides with point `p`; the point keeps the smallest input id.
-    fn record_duplicate(&mut self, i: usize, p: u32) {
-        self.input_point[i] = p;
+    fn record_duplicate(&mut self, i: InputId, p: PointId) {
+        self.input_point[i.index()] = p;
         self.duplicates += 1;
-        let first = &mut self.point_input[p as usize];
-        *first = (*first).min(i as u32);
+        let first = &mut self.point_input[p.index()];
+        *first = (*first).min(i);
     }
 
     /// Inserts one more point (wrapped into the domain); its input id is the number of
-    /// points given so far. Returns the vertex (point index) it became or coincides with.
+    /// points given so far. Returns the point (vertex of the quotient) it became or
+    /// coincides with.
     pub fn insert(&mut self, p: [f64; D]) -> Result<Inserted> {
         let i = self.input_point.len();
         let (w, moved) = internal_point(self.space(), i, &p)?;
         self.wrapped += moved as usize;
-        self.input_point.push(NONE);
-        Ok(self.insert_wrapped(i, w))
+        self.input_point.push(PointId::NONE);
+        Ok(self.insert_wrapped(InputId::new(i), w))
     }
 
     /// Inserts a batch of points, all or nothing: every point is checked and wrapped first,
@@ -356,22 +361,23 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     /// next to its target whatever the order of `points` (inserting points one by one in
     /// random order walks across the triangulation each time). Input ids follow the order of
     /// `points`, and a point met several times keeps the coordinates of its first
-    /// occurrence, as in [`Self::build`]. Returns, per point, the vertex (point index) it
-    /// became or coincides with.
+    /// occurrence, as in [`Self::build`]. Returns, per point, the point (vertex of the
+    /// quotient) it became or coincides with.
     pub fn insert_all(&mut self, points: &[[f64; D]]) -> Result<Vec<Inserted>> {
         let (internal, moved) = internal_points(self.space(), points)?;
         let first = self.input_point.len();
-        self.input_point.resize(first + points.len(), NONE);
+        self.input_point.resize(first + points.len(), PointId::NONE);
         self.wrapped += moved;
         let seed = BuildOptions::default().seed ^ first as u64;
-        let mut out = vec![Inserted::New(0); points.len()];
+        let mut out = vec![Inserted::New(PointId(0)); points.len()];
         for k in spatial_order(self.space(), &internal, seed) {
-            out[k as usize] = self.insert_wrapped(first + k as usize, internal[k as usize]);
+            let i = InputId::new(first + k as usize);
+            out[k as usize] = self.insert_wrapped(i, internal[k as usize]);
         }
         // a duplicate inserted before its first occurrence lent the point its coordinates
         for (k, r) in out.iter().enumerate() {
             let (Inserted::New(p) | Inserted::Duplicate(p)) = *r;
-            if self.point_input[p as usize] as usize == first + k {
+            if self.point_input[p.index()].index() == first + k {
                 self.represent(p, internal[k]);
             }
         }
@@ -438,52 +444,55 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         self.wrapped
     }
 
-    /// The distinct points (wrapped), indexed by vertex.
+    /// The distinct points (wrapped), indexed by [`PointId`].
     pub fn points(&self) -> Vec<[f64; D]> {
         (0..self.number_of_vertices() as u32)
-            .map(|v| self.point(v))
+            .map(|v| self.point(PointId(v)))
             .collect()
     }
 
-    /// The wrapped position of vertex `v` (a point index).
-    pub fn point(&self, v: u32) -> [f64; D] {
+    /// The wrapped position of point (vertex) `v`.
+    pub fn point(&self, v: PointId) -> [f64; D] {
         let space = self.space();
-        let p = self.engine.points()[v as usize];
+        let p = self.engine.points()[v.index()];
         space.to_user(space.lifted_position((p, space.identity())))
     }
 
     /// The position of input point `i`'s image under the group element `offset` (in a
     /// torus, `points[i] + offset·M`), in Cartesian coordinates.
-    pub fn position(&self, i: u32, offset: S::Elem) -> [f64; D] {
-        let p = self.engine.points()[self.vertex_of_input(i as usize) as usize];
+    pub fn position(&self, i: InputId, offset: S::Elem) -> [f64; D] {
+        let p = self.engine.points()[self.vertex_of_input(i).index()];
         let space = self.space();
         space.to_user(space.lifted_position((p, offset)))
     }
 
-    /// The vertex of input point `i`.
-    pub fn vertex_of_input(&self, i: usize) -> u32 {
-        self.input_point[i]
+    /// The point (vertex of the quotient) of input point `i`.
+    pub fn vertex_of_input(&self, i: InputId) -> PointId {
+        self.input_point[i.index()]
     }
 
-    /// The input id of vertex `v` (its first occurrence).
-    pub fn input_of_vertex(&self, v: u32) -> u32 {
-        self.point_input[v as usize]
+    /// The input id of point (vertex) `v`: its first occurrence.
+    pub fn input_of_vertex(&self, v: PointId) -> InputId {
+        self.point_input[v.index()]
     }
 
     /// For every input point, the input id of its first occurrence (itself unless duplicate).
-    pub fn first_occurrences(&self) -> Vec<u32> {
+    pub fn first_occurrences(&self) -> Vec<InputId> {
         self.input_point
             .iter()
-            .map(|&v| self.point_input[v as usize])
+            .map(|&v| self.point_input[v.index()])
             .collect()
     }
 
-    fn view(&self, c: u32) -> CellView<D, N, S::Elem> {
+    /// The input id of a stored vertex's point.
+    fn input_of(&self, v: VertexId) -> InputId {
+        self.point_input[self.engine.point_of(v).index()]
+    }
+
+    fn view(&self, c: CellId) -> CellView<D, N, S::Elem> {
         let cell = self.engine.cell(c);
         CellView {
-            vertices: cell
-                .v
-                .map(|x| self.point_input[self.engine.point_of(x) as usize]),
+            vertices: cell.v.map(|x| self.input_of(x)),
             offsets: cell.off,
         }
     }
@@ -496,16 +505,16 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     /// Every stored cell (as `stored_cells`) with its neighbours: `neighbors[k][i]` is the
     /// position in this list of the cell opposite vertex `i` of cell `k`.
     pub fn cells_with_neighbors(&self) -> (Vec<CellView<D, N, S::Elem>>, Vec<[u32; N]>) {
-        let ids: Vec<u32> = self.engine.cell_ids().collect();
-        let slots = ids.iter().max().map_or(0, |&m| m as usize + 1);
+        let ids: Vec<CellId> = self.engine.cell_ids().collect();
+        let slots = ids.iter().max().map_or(0, |m| m.index() + 1);
         let mut position = vec![u32::MAX; slots];
         for (k, &c) in ids.iter().enumerate() {
-            position[c as usize] = k as u32;
+            position[c.index()] = k as u32;
         }
         let views = ids.iter().map(|&c| self.view(c)).collect();
         let neighbors = ids
             .iter()
-            .map(|&c| self.engine.cell(c).n.map(|d| position[d as usize]))
+            .map(|&c| self.engine.cell(c).n.map(|d| position[d.index()]))
             .collect();
         (views, neighbors)
     }
@@ -521,15 +530,16 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             .collect()
     }
 
-    /// A face of a stored cell (the slots in `idx`): its vertices as input ids (`Unique`)
-    /// or stored vertex ids (`Stored`), in canonical form.
-    fn face(&self, c: u32, idx: &[usize], copies: Copies) -> Simplex<D, S::Elem> {
+    /// A face of a stored cell (the slots in `idx`), its vertices labelled by `id`, in
+    /// canonical form.
+    fn face<I: Copy + Into<u32> + From<u32>>(
+        &self,
+        c: CellId,
+        idx: &[usize],
+        id: impl Fn(VertexId) -> I,
+    ) -> Simplex<D, S::Elem, I> {
         let cell = self.engine.cell(c);
-        let id = |x: u32| match copies {
-            Copies::Unique => self.point_input[self.engine.point_of(x) as usize],
-            Copies::Stored => x,
-        };
-        let v: Vec<u32> = idx.iter().map(|&i| id(cell.v[i])).collect();
+        let v: Vec<I> = idx.iter().map(|&i| id(cell.v[i])).collect();
         let o: Vec<S::Elem> = idx.iter().map(|&i| cell.off[i]).collect();
         let (vertices, offsets) = canonical(self.space(), &v, &o);
         Simplex { vertices, offsets }
@@ -545,42 +555,54 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         out
     }
 
-    /// The edges (input ids, offsets), each once; `Stored` lists covering copies by vertex
-    /// id. Found from each vertex's neighbours, towards the larger vertex id.
-    pub fn edges(&self, copies: Copies) -> Vec<Simplex<D, S::Elem>> {
-        let id = move |x: u32| match copies {
-            Copies::Unique => self.point_input[self.engine.point_of(x) as usize],
-            Copies::Stored => x,
-        };
-        let all = (0..self.engine.number_of_vertices() as u32).flat_map(move |v| {
-            self.engine
-                .neighbours(v)
-                .into_iter()
-                .filter(move |w| w.0 > v)
-                .map(move |(w, rel)| {
-                    let (vertices, offsets) = canonical(
-                        self.space(),
-                        &[id(v), id(w)],
-                        &[self.space().identity(), rel],
-                    );
-                    Simplex { vertices, offsets }
-                })
-        });
-        if copies == Copies::Unique && !self.is_one_sheeted() {
-            return self.unique_in_covering(all);
+    /// Every stored edge, its vertices labelled by `id`: found from each vertex's
+    /// neighbours, towards the larger vertex id.
+    fn edges_labelled<'a, I: Copy + Into<u32> + From<u32> + 'a>(
+        &'a self,
+        id: impl Fn(VertexId) -> I + Copy + 'a,
+    ) -> impl Iterator<Item = Simplex<D, S::Elem, I>> + 'a {
+        (0..self.engine.number_of_vertices() as u32)
+            .map(VertexId)
+            .flat_map(move |v| {
+                self.engine
+                    .neighbours(v)
+                    .into_iter()
+                    .filter(move |w| w.0 > v)
+                    .map(move |(w, rel)| {
+                        let (vertices, offsets) = canonical(
+                            self.space(),
+                            &[id(v), id(w)],
+                            &[self.space().identity(), rel],
+                        );
+                        Simplex { vertices, offsets }
+                    })
+            })
+    }
+
+    /// The edges (input ids, offsets), one per edge of the quotient (CGAL's unique
+    /// iterators).
+    pub fn edges(&self) -> Vec<Simplex<D, S::Elem>> {
+        let all = self.edges_labelled(|v| self.input_of(v));
+        if self.is_one_sheeted() {
+            return all.collect();
         }
-        all.collect()
+        self.unique_in_covering(all)
+    }
+
+    /// Every stored edge (in a covering space, every copy), its vertices the stored ones:
+    /// [`VertexId`]s, which tell the copies of a point apart.
+    pub fn stored_edges(&self) -> Vec<Simplex<D, S::Elem, VertexId>> {
+        self.edges_labelled(|v| v).collect()
     }
 
     /// The Delaunay edges of the torus, each once, with input ids, shift and length.
     pub fn delaunay_edges(&self) -> Vec<DelaunayEdge<D, S::Elem>> {
         let space = self.space();
-        self.edges(Copies::Unique)
+        self.edges()
             .into_iter()
             .map(|s| {
                 let at = |k: usize| {
-                    let p =
-                        self.engine.points()[self.vertex_of_input(s.vertices[k] as usize) as usize];
+                    let p = self.engine.points()[self.vertex_of_input(s.vertices[k]).index()];
                     (p, s.offsets[k])
                 };
                 let d = space.lifted_difference(at(1), at(0));
@@ -595,32 +617,44 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             .collect()
     }
 
-    /// The facets, each once (from the cell with the smaller id); `Stored` lists covering
-    /// copies by vertex id.
-    pub fn facets(&self, copies: Copies) -> Vec<Simplex<D, S::Elem>> {
-        let all = self.engine.cell_ids().flat_map(|c| {
+    /// Every stored facet, once (from the cell with the smaller id), its vertices labelled by
+    /// `id`.
+    fn facets_labelled<'a, I: Copy + Into<u32> + From<u32> + 'a>(
+        &'a self,
+        id: impl Fn(VertexId) -> I + Copy + 'a,
+    ) -> impl Iterator<Item = Simplex<D, S::Elem, I>> + 'a {
+        self.engine.cell_ids().flat_map(move |c| {
             let n = self.engine.cell(c).n;
-            (0..N).filter(move |&i| c < n[i]).map(move |i| (c, i))
-        });
-        let face = |(c, i): (u32, usize)| {
-            let idx: Vec<usize> = (0..N).filter(|&k| k != i).collect();
-            self.face(c, &idx, copies)
-        };
-        if copies == Copies::Unique && !self.is_one_sheeted() {
-            return self.unique_in_covering(all.map(face));
+            (0..N).filter(move |&i| c < n[i]).map(move |i| {
+                let idx: Vec<usize> = (0..N).filter(|&k| k != i).collect();
+                self.face(c, &idx, id)
+            })
+        })
+    }
+
+    /// The facets (input ids, offsets), one per facet of the quotient.
+    pub fn facets(&self) -> Vec<Simplex<D, S::Elem>> {
+        let all = self.facets_labelled(|v| self.input_of(v));
+        if self.is_one_sheeted() {
+            return all.collect();
         }
-        all.map(face).collect()
+        self.unique_in_covering(all)
+    }
+
+    /// Every stored facet, by stored vertex (as [`Self::stored_edges`]).
+    pub fn stored_facets(&self) -> Vec<Simplex<D, S::Elem, VertexId>> {
+        self.facets_labelled(|v| v).collect()
     }
 
     /// The neighbours of input point `i`: (input id, offset of the neighbour relative to
     /// the point), one entry per Delaunay edge at the point, from the point's star.
-    pub fn vertex_neighbors(&self, i: usize) -> Vec<(u32, S::Elem)> {
-        let v = self.engine.vertex_of_point(self.input_point[i]);
-        let mut out: Vec<(u32, S::Elem)> = self
+    pub fn vertex_neighbors(&self, i: InputId) -> Vec<(InputId, S::Elem)> {
+        let v = self.engine.vertex_of_point(self.vertex_of_input(i));
+        let mut out: Vec<(InputId, S::Elem)> = self
             .engine
             .neighbours(v)
             .into_iter()
-            .map(|(w, rel)| (self.point_input[self.engine.point_of(w) as usize], rel))
+            .map(|(w, rel)| (self.input_of(w), rel))
             .collect();
         out.sort_unstable();
         out
@@ -643,12 +677,19 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
 }
 
 /// Canonical form modulo the group of a simplex given by vertices and elements.
-fn canonical<const D: usize, const N: usize, S: FlatSpace<D, N>>(
+/// (The space orders plain numbers: an id orders as its number.)
+fn canonical<
+    const D: usize,
+    const N: usize,
+    S: FlatSpace<D, N>,
+    I: Copy + Into<u32> + From<u32>,
+>(
     space: &S,
-    v: &[u32],
+    v: &[I],
     o: &[S::Elem],
-) -> (Vec<u32>, Vec<S::Elem>) {
-    let mut pairs: Vec<(u32, S::Elem)> = v.iter().copied().zip(o.iter().copied()).collect();
+) -> (Vec<I>, Vec<S::Elem>) {
+    let mut pairs: Vec<(u32, S::Elem)> =
+        v.iter().map(|&x| x.into()).zip(o.iter().copied()).collect();
     space.canonical_face(&mut pairs);
-    pairs.into_iter().unzip()
+    pairs.into_iter().map(|(x, g)| (I::from(x), g)).unzip()
 }

@@ -11,6 +11,7 @@
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
+use crate::ids::{CellId, InputId, PointId, VertexId};
 use crate::space::FlatSpace;
 use crate::triangulation::Triangulation;
 
@@ -21,7 +22,7 @@ pub struct VoronoiFace<const D: usize, E = [i8; D]> {
     /// the cell; in 2D the two ends of the edge.
     pub vertices: Vec<u32>,
     /// Input id of the neighbour (its first occurrence).
-    pub neighbor: u32,
+    pub neighbor: InputId,
     /// The neighbour's image across this face is `shift·points[neighbor]` (in a torus
     /// `points[neighbor] + shift·M`).
     pub shift: E,
@@ -34,7 +35,7 @@ pub struct VoronoiFace<const D: usize, E = [i8; D]> {
 #[derive(Clone, Debug, PartialEq)]
 pub struct VoronoiCell<const D: usize, E = [i8; D]> {
     /// Input id of the point (its first occurrence).
-    pub point: u32,
+    pub point: InputId,
     /// The point's wrapped position.
     pub position: [f64; D],
     pub vertices: Vec<[f64; D]>,
@@ -48,7 +49,7 @@ pub struct VoronoiCell<const D: usize, E = [i8; D]> {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CellMeasures<const D: usize> {
     /// Input id of the point (its first occurrence).
-    pub point: u32,
+    pub point: InputId,
     /// Volume (area in 2D).
     pub volume: f64,
     /// Number of faces (of neighbours, counting each image).
@@ -74,8 +75,8 @@ impl<const D: usize, E> From<&VoronoiCell<D, E>> for CellMeasures<D> {
 /// shares a face of this area with `i`. Each unordered pair of images is listed once.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Neighbor<const D: usize, E = [i8; D]> {
-    pub i: u32,
-    pub j: u32,
+    pub i: InputId,
+    pub j: InputId,
     pub shift: E,
     pub area: f64,
 }
@@ -125,14 +126,14 @@ struct Duals<const D: usize> {
     cospherical: Vec<u8>,
     /// The incident (cell, slot) pairs of vertex `v`: `incident[start[v]..start[v + 1]]`.
     start: Vec<u32>,
-    incident: Vec<(u32, u8)>,
+    incident: Vec<(CellId, u8)>,
 }
 
 impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> {
     /// The Voronoi cell of input point `i` (a duplicate gets its first occurrence's cell).
     /// It computes the circumcenters and cospherical classes of the whole triangulation
     /// first: for many cells, call [`Self::voronoi_cells`] once.
-    pub fn voronoi_cell(&self, i: usize) -> VoronoiCell<D, S::Elem> {
+    pub fn voronoi_cell(&self, i: InputId) -> VoronoiCell<D, S::Elem> {
         let duals = self.duals(&|| false).expect("never interrupted");
         self.cell_of_point(&duals, self.vertex_of_input(i))
     }
@@ -204,14 +205,14 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
                 if p % 1024 == 0 && interrupt() {
                     return Err(Error::Interrupted);
                 }
-                Ok(Some(f(self.cell_of_point(&duals, p))))
+                Ok(Some(f(self.cell_of_point(&duals, PointId(p)))))
             })
             .collect::<Result<_>>()?;
-        let mut order: Vec<u32> = (0..out.len() as u32).collect();
+        let mut order: Vec<PointId> = (0..out.len() as u32).map(PointId).collect();
         order.sort_unstable_by_key(|&p| self.input_of_vertex(p));
         Ok(order
             .iter()
-            .map(|&p| out[p as usize].take().expect("each point once"))
+            .map(|&p| out[p.index()].take().expect("each point once"))
             .collect())
     }
 
@@ -235,8 +236,8 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     fn duals(&self, interrupt: &(dyn Fn() -> bool + Sync)) -> Result<Duals<D>> {
         let e = self.engine();
         let space = self.space();
-        let ids: Vec<u32> = e.cell_ids().collect();
-        let slots = ids.iter().max().map_or(0, |&m| m as usize + 1);
+        let ids: Vec<CellId> = e.cell_ids().collect();
+        let slots = ids.iter().max().map_or(0, |m| m.index() + 1);
         let computed: Vec<[f64; D]> = ids
             .par_iter()
             .enumerate()
@@ -249,13 +250,13 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             .collect::<Result<_>>()?;
         let mut center = vec![[0.0; D]; slots];
         for (k, &c) in ids.iter().enumerate() {
-            center[c as usize] = computed[k];
+            center[c.index()] = computed[k];
         }
         if interrupt() {
             return Err(Error::Interrupted);
         }
         // adjacent cells with one circumsphere: decided exactly, each facet once
-        let merges: Vec<(u32, usize, u32, usize)> = ids
+        let merges: Vec<(CellId, usize, CellId, usize)> = ids
             .par_iter()
             .flat_map_iter(|&c| {
                 let cell = e.cell(c);
@@ -271,7 +272,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
                         .expect("symmetric neighbours");
                     let shift = e.translation(c, x, d);
                     let opposite = (
-                        e.points()[e.point_of(dc.v[y]) as usize],
+                        e.points()[e.point_of(dc.v[y]).index()],
                         space.compose(shift, dc.off[y]),
                     );
                     space.cospherical(&lifted, opposite).then_some((c, x, d, y))
@@ -280,26 +281,26 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             .collect();
         let mut cospherical = vec![0u8; slots];
         for (c, x, d, y) in merges {
-            cospherical[c as usize] |= 1 << x;
-            cospherical[d as usize] |= 1 << y;
+            cospherical[c.index()] |= 1 << x;
+            cospherical[d.index()] |= 1 << y;
         }
         // incidence lists by counting sort
         let vertices = e.number_of_vertices();
         let mut start = vec![0u32; vertices + 1];
         for &c in &ids {
             for &v in &e.cell(c).v {
-                start[v as usize + 1] += 1;
+                start[v.index() + 1] += 1;
             }
         }
         for v in 0..vertices {
             start[v + 1] += start[v];
         }
         let mut fill = start.clone();
-        let mut incident = vec![(0u32, 0u8); start[vertices] as usize];
+        let mut incident = vec![(CellId(0), 0u8); start[vertices] as usize];
         for &c in &ids {
             for (k, &v) in e.cell(c).v.iter().enumerate() {
-                incident[fill[v as usize] as usize] = (c, k as u8);
-                fill[v as usize] += 1;
+                incident[fill[v.index()] as usize] = (c, k as u8);
+                fill[v.index()] += 1;
             }
         }
         Ok(Duals {
@@ -310,14 +311,13 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         })
     }
 
-    /// The cell of point index `p`, from the cells around one of its vertices.
-    fn cell_of_point(&self, duals: &Duals<D>, p: u32) -> VoronoiCell<D, S::Elem> {
+    /// The cell of point `p`, from the cells around one of its vertices.
+    fn cell_of_point(&self, duals: &Duals<D>, p: PointId) -> VoronoiCell<D, S::Elem> {
         let e = self.engine();
         let space = self.space();
-        let v = e.vertex_of_point(p);
-        let star =
-            &duals.incident[duals.start[v as usize] as usize..duals.start[v as usize + 1] as usize];
-        let position = e.points()[p as usize];
+        let v = e.vertex_of_point(p).index();
+        let star = &duals.incident[duals.start[v] as usize..duals.start[v + 1] as usize];
+        let position = e.points()[p.index()];
         // one Voronoi vertex per group of star cells joined, through facets at the point, by
         // a shared circumsphere (so in one lift around the point: a sphere met again around
         // the torus at another lift of the point is another vertex)
@@ -325,7 +325,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         for (s, &(c, k)) in star.iter().enumerate() {
             let cell = e.cell(c);
             for x in
-                (0..N).filter(|&x| x != k as usize && duals.cospherical[c as usize] >> x & 1 == 1)
+                (0..N).filter(|&x| x != k as usize && duals.cospherical[c.index()] >> x & 1 == 1)
             {
                 let d = cell.n[x];
                 let t = star
@@ -347,7 +347,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
                     // the point's own frame is that of its element in the cell
                     let at = e.lifted(c, k as usize);
                     let to_point = space.lifted_difference(at, e.lifted(c, 0));
-                    let z = duals.center[c as usize];
+                    let z = duals.center[c.index()];
                     vertices.push(space.untwist(at.1, std::array::from_fn(|x| z[x] - to_point[x])));
                     vertex_of_root[r] = vertices.len() as u32 - 1;
                 }
@@ -355,7 +355,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             })
             .collect();
         // faces: the ring of star cells around each Delaunay edge at the point
-        let mut edges: Vec<(u32, S::Elem)> = Vec::new();
+        let mut edges: Vec<(VertexId, S::Elem)> = Vec::new();
         let mut member: Vec<(u32, u32)> = Vec::with_capacity(star.len() * (N - 1));
         for (s, &(c, k)) in star.iter().enumerate() {
             let cell = e.cell(c);
@@ -382,7 +382,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             if ids.len() < D {
                 continue; // the dual of this Delaunay edge has collapsed: no face
             }
-            let wp = e.points()[e.point_of(w) as usize];
+            let wp = e.points()[e.point_of(w).index()];
             let dir = space.lifted_difference((wp, r), (position, space.identity()));
             let pts: Vec<&[f64]> = ids.iter().map(|&i| &vertices[i as usize][..]).collect();
             let area = if D == 2 {
@@ -425,10 +425,16 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
 
     /// The star cells around the Delaunay edge from the point to `(w, r)`, in cyclic order:
     /// consecutive cells share a facet holding both ends of the edge.
-    fn ring_cycle(&self, star: &[(u32, u8)], ring: &[usize], w: u32, r: S::Elem) -> Vec<usize> {
+    fn ring_cycle(
+        &self,
+        star: &[(CellId, u8)],
+        ring: &[usize],
+        w: VertexId,
+        r: S::Elem,
+    ) -> Vec<usize> {
         let e = self.engine();
         let mut cycle = vec![ring[0]];
-        let mut prev = u32::MAX;
+        let mut prev = CellId::NONE;
         loop {
             let (c, k) = star[*cycle.last().unwrap()];
             let k = k as usize;

@@ -3,7 +3,7 @@
 
 mod common;
 use orbitri::{
-    Copies, Error, FlatTorus2, FlatTorus3, Inserted, PeriodicDelaunay2, PeriodicDelaunay3,
+    Copies, Error, FlatTorus2, FlatTorus3, InputId, Inserted, PeriodicDelaunay2, PeriodicDelaunay3,
 };
 
 fn sorted<T: Ord>(mut v: Vec<T>) -> Vec<T> {
@@ -39,7 +39,7 @@ fn a_batch_equals_the_bulk_build_of_everything() {
     );
     assert_eq!(tri.first_occurrences(), bulk.first_occurrences());
     assert_eq!(tri.points().len(), bulk.points().len());
-    for i in 0..all.len() {
+    for i in (0..all.len()).map(InputId::new) {
         assert_eq!(
             tri.point(tri.vertex_of_input(i)),
             bulk.point(bulk.vertex_of_input(i)),

@@ -4,7 +4,7 @@
 mod common;
 use common::*;
 use orbitri::sort::SplitMix;
-use orbitri::{BuildOptions, Copies, FlatTorus3, Inserted, PeriodicDelaunay3};
+use orbitri::{BuildOptions, Copies, FlatTorus3, InputId, Inserted, PeriodicDelaunay3, PointId};
 
 fn build(space: FlatTorus3, pts: &[[f64; 3]], opts: BuildOptions) -> PeriodicDelaunay3 {
     let tri =
@@ -34,8 +34,8 @@ fn tiny_sets_stay_in_the_covering_and_are_correct() {
             assert!(!tri.is_one_sheeted());
         }
         // Euler: in the covering, every vertex copy has 6 cells on average... V − E + F − C = 0
-        let e = tri.edges(Copies::Stored).len();
-        let f = tri.facets(Copies::Stored).len();
+        let e = tri.stored_edges().len();
+        let f = tri.stored_facets().len();
         let v = tri.number_of_vertices() * tri.sheets();
         assert_eq!(
             v as i64 - e as i64 + f as i64 - tri.number_of_cells() as i64,
@@ -100,7 +100,7 @@ fn insertion_order_does_not_matter() {
                 .cells(Copies::Unique)
                 .into_iter()
                 .map(|mut c| {
-                    c.vertices = c.vertices.map(|v| perm[v as usize] as u32);
+                    c.vertices = c.vertices.map(|v| InputId::new(perm[v.index()]));
                     c
                 })
                 .collect();
@@ -184,13 +184,22 @@ fn duplicates_and_wrapping_lose_nothing() {
     assert_eq!(tri.number_of_vertices(), 502);
     assert_eq!(tri.wrapped(), 3);
     let first = tri.first_occurrences();
-    assert_eq!(first[500], 10);
-    assert_eq!(first[501], 20);
-    assert_eq!(first[502], 502);
-    assert_eq!(tri.point(tri.vertex_of_input(502)), [0.0, 0.5, 0.5]);
-    assert_eq!(tri.point(tri.vertex_of_input(503)), [0.0, 0.25, 0.0]);
+    assert_eq!(first[500], InputId(10));
+    assert_eq!(first[501], InputId(20));
+    assert_eq!(first[502], InputId(502));
+    assert_eq!(
+        tri.point(tri.vertex_of_input(InputId(502))),
+        [0.0, 0.5, 0.5]
+    );
+    assert_eq!(
+        tri.point(tri.vertex_of_input(InputId(503))),
+        [0.0, 0.25, 0.0]
+    );
     for (i, f) in first.iter().enumerate() {
-        assert_eq!(tri.input_of_vertex(tri.vertex_of_input(i)), *f);
+        assert_eq!(
+            tri.input_of_vertex(tri.vertex_of_input(InputId::new(i))),
+            *f
+        );
     }
 }
 
@@ -199,12 +208,13 @@ fn incremental_insertion_matches_bulk() {
     let pts = uniform(700, 8, [1.0; 3]);
     let mut inc = PeriodicDelaunay3::new(FlatTorus3::cuboid([1.0; 3]).unwrap());
     for (i, p) in pts.iter().enumerate() {
-        assert_eq!(inc.insert(*p).unwrap(), Inserted::New(i as u32));
+        // inserted one by one, a point's id is its input id
+        assert_eq!(inc.insert(*p).unwrap(), Inserted::New(PointId::new(i)));
         if i < 4 {
             assert_eq!(inc.sheets(), 27);
         }
     }
-    assert_eq!(inc.insert(pts[3]).unwrap(), Inserted::Duplicate(3));
+    assert_eq!(inc.insert(pts[3]).unwrap(), Inserted::Duplicate(PointId(3)));
     inc.is_valid().unwrap();
     let bulk = build(
         FlatTorus3::cuboid([1.0; 3]).unwrap(),
@@ -255,14 +265,16 @@ fn access_api() {
         BuildOptions::default(),
     );
     let cells = tri.cells(Copies::Unique);
-    let edges = tri.edges(Copies::Unique);
-    let facets = tri.facets(Copies::Unique);
+    let edges = tri.edges();
+    let facets = tri.facets();
     assert_eq!(facets.len(), 2 * cells.len());
     assert_eq!(edges.len(), tri.number_of_vertices() + cells.len());
-    let degree_sum: usize = (0..pts.len()).map(|i| tri.vertex_neighbors(i).len()).sum();
+    let degree_sum: usize = (0..pts.len())
+        .map(|i| tri.vertex_neighbors(InputId::new(i)).len())
+        .sum();
     assert_eq!(degree_sum, 2 * edges.len());
-    for n in tri.vertex_neighbors(0) {
-        let d = [0, 1, 2].map(|c| pts[n.0 as usize][c] + n.1[c] as f64 - pts[0][c]);
+    for n in tri.vertex_neighbors(InputId(0)) {
+        let d = [0, 1, 2].map(|c| pts[n.0.index()][c] + n.1[c] as f64 - pts[0][c]);
         assert!(
             d.iter().map(|x| x * x).sum::<f64>() < 0.5,
             "neighbour far away: {n:?}"
@@ -277,8 +289,7 @@ fn access_api() {
         let wq = tri.space().lattice().wrap(*q).unwrap().0;
         let corner = |i: usize| {
             [0, 1, 2].map(|c| {
-                tri.point(tri.vertex_of_input(cell.vertices[i] as usize))[c]
-                    + cell.offsets[i][c] as f64
+                tri.point(tri.vertex_of_input(cell.vertices[i]))[c] + cell.offsets[i][c] as f64
             })
         };
         let qq = [0, 1, 2].map(|c| wq[c] + o[c] as f64);
@@ -303,8 +314,10 @@ fn access_api() {
         27 * small.cells(Copies::Unique).len()
     );
     // neighbours from a vertex's star agree with the unique edges, also in the covering
-    let degrees: usize = (0..3).map(|i| small.vertex_neighbors(i).len()).sum();
-    assert_eq!(degrees, 2 * small.edges(Copies::Unique).len());
+    let degrees: usize = (0..3)
+        .map(|i| small.vertex_neighbors(InputId(i)).len())
+        .sum();
+    assert_eq!(degrees, 2 * small.edges().len());
 }
 
 #[test]
@@ -395,7 +408,7 @@ fn degenerate_point_sets() {
         (tri.number_of_vertices(), tri.duplicates(), tri.sheets()),
         (1, 49, 27)
     );
-    assert_eq!(tri.first_occurrences(), vec![0; 50]);
+    assert_eq!(tri.first_occurrences(), vec![InputId(0); 50]);
     // all points on one plane, on one line, and on a plane of a grid
     let mut r = SplitMix::new(17);
     let plane: Vec<[f64; 3]> = (0..150).map(|_| [r.unit(), r.unit(), 0.5]).collect();

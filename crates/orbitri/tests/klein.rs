@@ -6,7 +6,8 @@ use std::collections::{BTreeSet, HashMap};
 
 use orbitri::sort::SplitMix;
 use orbitri::{
-    Copies, FlatManifold, FlatSpace, FlatTorus2, KleinTriangulation, Motion, PeriodicDelaunay2,
+    Copies, FlatManifold, FlatSpace, FlatTorus2, InputId, KleinTriangulation, Motion,
+    PeriodicDelaunay2, PointId,
 };
 
 fn random(n: usize, seed: u64, a: f64, b: f64) -> Vec<[f64; 2]> {
@@ -81,7 +82,7 @@ fn unfolding_gives_the_torus_triangulation_of_the_cover() {
     let unfolded = PeriodicDelaunay2::build(torus, &cover).unwrap();
     assert!(unfolded.is_one_sheeted());
     // the torus's cells as sets of (cover point, offset), least offset at zero
-    let canon = |mut c: Vec<(u32, [i8; 2])>| {
+    let canon = |mut c: Vec<(InputId, [i8; 2])>| {
         for k in 0..2 {
             let m = c.iter().map(|x| x.1[k]).min().unwrap();
             c.iter_mut().for_each(|x| x.1[k] -= m);
@@ -89,7 +90,7 @@ fn unfolding_gives_the_torus_triangulation_of_the_cover() {
         c.sort_unstable();
         c
     };
-    let expected: BTreeSet<Vec<(u32, [i8; 2])>> = unfolded
+    let expected: BTreeSet<Vec<(InputId, [i8; 2])>> = unfolded
         .cells(Copies::Unique)
         .iter()
         .map(|c| canon(c.vertices.iter().copied().zip(c.offsets).collect()))
@@ -105,14 +106,15 @@ fn unfolding_gives_the_torus_triangulation_of_the_cover() {
             },
             glide,
         ] {
-            let cell: Vec<(u32, [i8; 2])> = (0..3)
+            let cell: Vec<(InputId, [i8; 2])> = (0..3)
                 .map(|k| {
-                    let v = tri.vertex_of_input(c.vertices[k] as usize);
+                    let v = tri.vertex_of_input(c.vertices[k]);
                     let g = klein_compose(&klein, r, c.offsets[k]);
                     let x = apply(&klein, g, tri.point(v));
-                    // the cover point it is a translate of
-                    let u = if g.coset == 0 { v } else { v + n };
-                    let base = cover[u as usize];
+                    // the cover point it is a translate of: the cover's input `v` is point
+                    // `v`, its input `v + n` the glide image
+                    let u = InputId(if g.coset == 0 { v.0 } else { v.0 + n });
+                    let base = cover[u.index()];
                     let o = [
                         ((x[0] - base[0]) / (2.0 * a)).round() as i8,
                         ((x[1] - base[1]) / b).round() as i8,
@@ -133,23 +135,27 @@ fn klein_compose(klein: &FlatManifold<2>, a: Motion<2>, b: Motion<2>) -> Motion<
 
 /// Cells as sets of (point coordinates, element) in canonical form modulo the group.
 fn geometry(tri: &KleinTriangulation) -> BTreeSet<Vec<(u64, u64, Motion<2>)>> {
-    let key: HashMap<u32, u32> = (0..tri.number_of_vertices() as u32)
-        .map(|v| (tri.input_of_vertex(v), v))
+    let key: HashMap<InputId, PointId> = (0..tri.number_of_vertices() as u32)
+        .map(|v| (tri.input_of_vertex(PointId(v)), PointId(v)))
         .collect();
     tri.cells(Copies::Unique)
         .iter()
         .map(|c| {
-            let mut pairs: Vec<(u32, Motion<2>)> =
-                c.vertices.iter().copied().zip(c.offsets).collect();
             // rank vertices by their coordinates, so that input order does not matter
-            let mut order: Vec<u32> = (0..tri.number_of_vertices() as u32).collect();
+            let mut order: Vec<PointId> =
+                (0..tri.number_of_vertices() as u32).map(PointId).collect();
             order.sort_by(|&x, &y| tri.point(x).partial_cmp(&tri.point(y)).unwrap());
-            let rank: HashMap<u32, u32> = order
+            let rank: HashMap<PointId, u32> = order
                 .iter()
                 .enumerate()
                 .map(|(r, &v)| (v, r as u32))
                 .collect();
-            pairs.iter_mut().for_each(|p| p.0 = rank[&key[&p.0]]);
+            let mut pairs: Vec<(u32, Motion<2>)> = c
+                .vertices
+                .iter()
+                .map(|v| rank[&key[v]])
+                .zip(c.offsets)
+                .collect();
             FlatSpace::<2, 3>::canonical_face(tri.space(), &mut pairs);
             pairs
                 .iter()
@@ -213,7 +219,7 @@ fn glide_images_are_duplicates() {
     tri.is_valid().unwrap();
     assert_eq!(tri.number_of_vertices(), 50);
     assert_eq!(tri.duplicates(), 100);
-    assert_eq!(tri.first_occurrences()[60], 10);
+    assert_eq!(tri.first_occurrences()[60], InputId(10));
     assert_eq!(tri.wrapped(), 100);
 }
 

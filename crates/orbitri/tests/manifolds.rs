@@ -9,8 +9,8 @@ use std::ops::ControlFlow;
 use common::universal::{check, Isometry, Manifold};
 use orbitri::sort::SplitMix;
 use orbitri::{
-    BuildOptions, Copies, FlatManifold, FlatSpace, FlatTorus, Motion, OrbitSpace, PeriodicDelaunay,
-    Triangulation,
+    BuildOptions, Copies, FlatManifold, FlatSpace, FlatTorus, InputId, Motion, OrbitSpace,
+    PeriodicDelaunay, Triangulation,
 };
 
 fn random<const D: usize>(n: usize, seed: u64, scale: [f64; D]) -> Vec<[f64; D]> {
@@ -65,7 +65,7 @@ where
         .iter()
         .map(|c| {
             (
-                c.vertices.map(|i| tri.vertex_of_input(i as usize)),
+                c.vertices.map(|i| tri.vertex_of_input(i).0),
                 c.offsets.map(|g| isometry(m, g)),
             )
         })
@@ -142,7 +142,7 @@ where
         .iter()
         .map(|c| {
             (
-                c.vertices.map(|i| tri.vertex_of_input(i as usize)),
+                c.vertices.map(|i| tri.vertex_of_input(i).0),
                 c.offsets.map(element),
             )
         })
@@ -283,6 +283,7 @@ where
         }
     }
     let unfolded = PeriodicDelaunay::<D, N>::build(torus.clone(), &cover).unwrap();
+    // (the cover's input ids, as numbers)
     let canon = |mut cell: Vec<(u32, [i8; D])>| {
         FlatSpace::<D, N>::canonical_face(&torus, &mut cell);
         cell
@@ -290,7 +291,7 @@ where
     let expected: BTreeSet<Vec<(u32, [i8; D])>> = unfolded
         .cells(Copies::Unique)
         .iter()
-        .map(|c| canon(c.vertices.iter().copied().zip(c.offsets).collect()))
+        .map(|c| canon(c.vertices.iter().map(|v| v.0).zip(c.offsets).collect()))
         .collect();
     let inv = m.translations().clone();
     let mut lifted = BTreeSet::new();
@@ -298,10 +299,10 @@ where
         for r in 0..k {
             let cell = (0..N)
                 .map(|j| {
-                    let v = tri.vertex_of_input(c.vertices[j] as usize);
+                    let v = tri.vertex_of_input(c.vertices[j]);
                     let g = OrbitSpace::<N>::compose(&m, coset(r), c.offsets[j]);
-                    let x = apply(g, pts[v as usize]);
-                    let u = g.coset as u32 * pts.len() as u32 + v;
+                    let x = apply(g, pts[v.index()]);
+                    let u = g.coset as u32 * pts.len() as u32 + v.0;
                     let d: [f64; D] = std::array::from_fn(|i| x[i] - cover[u as usize][i]);
                     (u, inv.fractional(&d).map(|f| f.round() as i8))
                 })
@@ -317,12 +318,13 @@ where
     let there = unfolded.voronoi_cells();
     let mut at_vertex = vec![usize::MAX; unfolded.number_of_vertices()];
     for (i, x) in there.iter().enumerate() {
-        at_vertex[unfolded.vertex_of_input(x.point as usize) as usize] = i;
+        at_vertex[unfolded.vertex_of_input(x.point).index()] = i;
     }
     for cell in &here {
-        let v = tri.vertex_of_input(cell.point as usize) as usize;
+        let v = tri.vertex_of_input(cell.point).index();
         for c in 0..k {
-            let w = &there[at_vertex[unfolded.vertex_of_input(c * pts.len() + v) as usize]];
+            let u = InputId::new(c * pts.len() + v);
+            let w = &there[at_vertex[unfolded.vertex_of_input(u).index()]];
             assert!(
                 (cell.volume - w.volume).abs() <= 1e-12 * cell.volume,
                 "{what}: point {v}: {} here, {} in the cover",
@@ -363,7 +365,7 @@ where
             let mut pairs: Vec<(u32, Motion<D>)> = (0..N)
                 .map(|k| {
                     (
-                        rank[tri.vertex_of_input(c.vertices[k] as usize) as usize],
+                        rank[tri.vertex_of_input(c.vertices[k]).index()],
                         c.offsets[k],
                     )
                 })
@@ -469,7 +471,7 @@ fn images_under_the_group_are_duplicates() {
         assert_eq!(tri.duplicates(), all.len() - pts.len(), "{name}");
         let first = tri.first_occurrences();
         assert!(
-            (0..all.len()).all(|i| first[i] as usize == i % pts.len()),
+            (0..all.len()).all(|i| first[i].index() == i % pts.len()),
             "{name}"
         );
     }

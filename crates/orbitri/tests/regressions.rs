@@ -2,7 +2,7 @@
 
 mod common;
 use common::*;
-use orbitri::{BuildOptions, Copies, FlatTorus3, PeriodicDelaunay3};
+use orbitri::{BuildOptions, Copies, FlatTorus3, InputId, PeriodicDelaunay3};
 
 fn check(space: FlatTorus3, pts: &[[f64; 3]], dummy_threshold: usize) {
     let opts = BuildOptions {
@@ -60,6 +60,6 @@ fn a_duplicate_keeps_the_coordinates_of_its_first_occurrence() {
         canonical_cells(&bulk.cells(Copies::Unique))
     );
     let wrapped_c = bulk.space().lattice().wrap(pts[0]).unwrap().0;
-    assert_eq!(bulk.point(bulk.vertex_of_input(0)), wrapped_c);
-    assert_eq!(inc.point(inc.vertex_of_input(0)), wrapped_c);
+    assert_eq!(bulk.point(bulk.vertex_of_input(InputId(0))), wrapped_c);
+    assert_eq!(inc.point(inc.vertex_of_input(InputId(0))), wrapped_c);
 }

@@ -8,7 +8,8 @@ use std::collections::HashMap;
 use orbitri::sort::SplitMix;
 use orbitri::space::{FlatTorus, Ladder, Lattice};
 use orbitri::{
-    BuildOptions, CellView, Copies, Engine, FlatTorus2, Inserted, OrbitSpace, PeriodicDelaunay2,
+    BuildOptions, CellView, Copies, Engine, FlatTorus2, InputId, Inserted, OrbitSpace,
+    PeriodicDelaunay2, PointId,
 };
 
 fn data(name: &str) -> String {
@@ -50,9 +51,9 @@ fn brute_force(tri: &PeriodicDelaunay2) {
     let area_dom = det.abs();
     let sheets = tri.sheets();
     let cells = tri.cells(Copies::Stored);
-    let point = |i: u32| tri.point(tri.vertex_of_input(i as usize));
+    let point = |i: InputId| tri.point(tri.vertex_of_input(i));
     let mut total = 0.0;
-    let mut edges: HashMap<Vec<(u32, [i8; 2])>, usize> = HashMap::new();
+    let mut edges: HashMap<Vec<(InputId, [i8; 2])>, usize> = HashMap::new();
     for c in &cells {
         let p: [[f64; 2]; 3] =
             std::array::from_fn(|i| lift(point(c.vertices[i]), c.offsets[i], &m));
@@ -78,7 +79,7 @@ fn brute_force(tri: &PeriodicDelaunay2) {
         ];
         let span: [f64; 2] = std::array::from_fn(|j| r * inv[0][j].hypot(inv[1][j]) * 1.001);
         for (v, &q) in tri.points().iter().enumerate() {
-            let i = tri.input_of_vertex(v as u32);
+            let i = tri.input_of_vertex(PointId::new(v));
             let fq = [
                 q[0] * inv[0][0] + q[1] * inv[1][0],
                 q[0] * inv[0][1] + q[1] * inv[1][1],
@@ -101,7 +102,7 @@ fn brute_force(tri: &PeriodicDelaunay2) {
             }
         }
         for skip in 0..3 {
-            let mut f: Vec<(u32, [i8; 2])> = (0..3)
+            let mut f: Vec<(InputId, [i8; 2])> = (0..3)
                 .filter(|&k| k != skip)
                 .map(|k| (c.vertices[k], c.offsets[k]))
                 .collect();
@@ -133,7 +134,7 @@ fn canonical(cells: &[CellView<2, 3>]) -> Vec<[i64; 9]> {
     let mut out: Vec<[i64; 9]> = cells
         .iter()
         .map(|c| {
-            let mut pairs: Vec<(u32, [i8; 2])> =
+            let mut pairs: Vec<(InputId, [i8; 2])> =
                 (0..3).map(|i| (c.vertices[i], c.offsets[i])).collect();
             pairs.sort_unstable();
             for k in 0..2 {
@@ -142,7 +143,7 @@ fn canonical(cells: &[CellView<2, 3>]) -> Vec<[i64; 9]> {
             }
             let mut line = [0i64; 9];
             for (i, (v, o)) in pairs.iter().enumerate() {
-                line[i] = *v as i64;
+                line[i] = i64::from(v.0);
                 line[3 + 2 * i] = o[0] as i64;
                 line[4 + 2 * i] = o[1] as i64;
             }
@@ -339,7 +340,7 @@ fn cocircular_grids_triangulate_exactly() {
             .cells(Copies::Unique)
             .into_iter()
             .map(|c| CellView {
-                vertices: c.vertices.map(|v| n as u32 - 1 - v),
+                vertices: c.vertices.map(|v| InputId(n as u32 - 1 - v.0)),
                 offsets: c.offsets,
             })
             .collect();
@@ -389,14 +390,14 @@ fn insertion_order_and_construction_path_do_not_matter() {
         let mut order = Vec::new();
         for &i in &shuffled {
             inc.insert(pts[i]).unwrap();
-            order.push(i as u32);
+            order.push(InputId::new(i));
         }
         // incremental input ids follow the shuffled order: map them back
         let back: Vec<CellView<2, 3>> = inc
             .cells(Copies::Unique)
             .into_iter()
             .map(|c| CellView {
-                vertices: c.vertices.map(|v| order[v as usize]),
+                vertices: c.vertices.map(|v| order[v.index()]),
                 offsets: c.offsets,
             })
             .collect();
@@ -422,11 +423,14 @@ fn duplicates_and_wrapping_lose_nothing_in_2d() {
     assert_eq!(tri.wrapped(), 2);
     assert_eq!(tri.number_of_vertices(), all.len() - 3);
     let firsts = tri.first_occurrences();
-    assert_eq!(&firsts[..6], &[0, 0, 2, 2, 4, 0]);
+    assert_eq!(&firsts[..6], &[0, 0, 2, 2, 4, 0].map(InputId));
     brute_force(&tri);
     let mut inc = PeriodicDelaunay2::new(torus);
-    assert_eq!(inc.insert([0.5, 0.5]).unwrap(), Inserted::New(0));
-    assert_eq!(inc.insert([2.5, -0.5]).unwrap(), Inserted::Duplicate(0));
+    assert_eq!(inc.insert([0.5, 0.5]).unwrap(), Inserted::New(PointId(0)));
+    assert_eq!(
+        inc.insert([2.5, -0.5]).unwrap(),
+        Inserted::Duplicate(PointId(0))
+    );
 }
 
 #[test]
@@ -434,12 +438,14 @@ fn access_api_in_2d() {
     let lattice = Lattice::new([[1.0, 0.0], [0.5, 0.9]]).unwrap();
     let pts = uniform(&lattice, 300, 12);
     let tri = PeriodicDelaunay2::build(FlatTorus::new(lattice), &pts).unwrap();
-    let edges = tri.edges(Copies::Unique);
+    let edges = tri.edges();
     // Euler: V − E + F = 0, and each vertex's neighbour list matches the edges at it
     assert_eq!(300 + tri.number_of_cells(), edges.len());
-    let degree: usize = (0..300).map(|i| tri.vertex_neighbors(i).len()).sum();
+    let degree: usize = (0..300)
+        .map(|i| tri.vertex_neighbors(InputId(i)).len())
+        .sum();
     assert_eq!(degree, 2 * edges.len());
-    assert_eq!(tri.facets(Copies::Unique).len(), edges.len());
+    assert_eq!(tri.facets().len(), edges.len());
     // the located triangle contains the query (barycentric test, independent)
     let m = tri.space().lattice().vectors();
     for q in [[0.3, 0.2], [0.99, 0.01], [1.2, 0.85]] {
@@ -449,7 +455,7 @@ fn access_api_in_2d() {
         let p: Vec<[f64; 2]> = (0..3)
             .map(|i| {
                 lift(
-                    tri.point(tri.vertex_of_input(c.vertices[i] as usize)),
+                    tri.point(tri.vertex_of_input(c.vertices[i])),
                     c.offsets[i],
                     &m,
                 )

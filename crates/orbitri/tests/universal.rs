@@ -41,7 +41,7 @@ where
         .iter()
         .map(|c| {
             (
-                c.vertices.map(|i| tri.vertex_of_input(i as usize)),
+                c.vertices.map(|i| tri.vertex_of_input(i).0),
                 std::array::from_fn(|k| Isometry::translation(translation(&rows, &c.offsets[k]))),
             )
         })

@@ -11,7 +11,8 @@ use common::crystal;
 
 use orbitri::sort::SplitMix;
 use orbitri::{
-    FlatTorus, FlatTorus2, FlatTorus3, Lattice, PeriodicDelaunay2, PeriodicDelaunay3, VoronoiCell,
+    FlatTorus, FlatTorus2, FlatTorus3, InputId, Lattice, PeriodicDelaunay2, PeriodicDelaunay3,
+    VoronoiCell,
 };
 
 type Poly3 = Vec<Vec<[f64; 3]>>;
@@ -229,12 +230,13 @@ fn clipped2(m: [[f64; 2]; 2], pts: &[[f64; 2]], i: usize) -> (f64, BTreeSet<(u32
     (area / 2.0, nb)
 }
 
+/// (neighbour's input id, shift) of every face, as the clipping lists them.
 fn faces_of<const D: usize>(c: &VoronoiCell<D>) -> BTreeSet<(u32, [i8; D])> {
-    c.faces.iter().map(|f| (f.neighbor, f.shift)).collect()
+    c.faces.iter().map(|f| (f.neighbor.0, f.shift)).collect()
 }
 
 fn check_pairs<const D: usize>(cells: &[VoronoiCell<D>]) {
-    let by_point: std::collections::HashMap<u32, &VoronoiCell<D>> =
+    let by_point: std::collections::HashMap<InputId, &VoronoiCell<D>> =
         cells.iter().map(|c| (c.point, c)).collect();
     for c in cells {
         for f in &c.faces {
@@ -280,14 +282,15 @@ fn cells_equal_clipped_cells_in_3d() {
             let pts = uniform3(&lattice, n, seed);
             let tri = PeriodicDelaunay3::build(FlatTorus::new(lattice.clone()), &pts).unwrap();
             let m = lattice.vectors();
-            let wrapped: Vec<[f64; 3]> =
-                (0..n).map(|i| tri.point(tri.vertex_of_input(i))).collect();
+            let wrapped: Vec<[f64; 3]> = (0..n)
+                .map(|i| tri.point(tri.vertex_of_input(InputId::new(i))))
+                .collect();
             let cells = tri.voronoi_cells();
             let total: f64 = cells.iter().map(|c| c.volume).sum();
             assert!((total - lattice.volume()).abs() <= 1e-12 * lattice.volume());
             check_pairs(&cells);
             for c in &cells {
-                let (vol, nb) = clipped3(m, &wrapped, c.point as usize);
+                let (vol, nb) = clipped3(m, &wrapped, c.point.index());
                 assert!(
                     (c.volume - vol).abs() <= 1e-9 * vol,
                     "n={n} point {}: {} vs clipped {vol}",
@@ -313,14 +316,15 @@ fn cells_equal_clipped_cells_in_2d() {
             let pts = uniform2(&lattice, n, seed);
             let tri = PeriodicDelaunay2::build(FlatTorus::new(lattice.clone()), &pts).unwrap();
             let m = lattice.vectors();
-            let wrapped: Vec<[f64; 2]> =
-                (0..n).map(|i| tri.point(tri.vertex_of_input(i))).collect();
+            let wrapped: Vec<[f64; 2]> = (0..n)
+                .map(|i| tri.point(tri.vertex_of_input(InputId::new(i))))
+                .collect();
             let cells = tri.voronoi_cells();
             let total: f64 = cells.iter().map(|c| c.volume).sum();
             assert!((total - lattice.volume()).abs() <= 1e-12 * lattice.volume());
             check_pairs(&cells);
             for c in &cells {
-                let (area, nb) = clipped2(m, &wrapped, c.point as usize);
+                let (area, nb) = clipped2(m, &wrapped, c.point.index());
                 assert!((c.volume - area).abs() <= 1e-9 * area);
                 assert_eq!(faces_of(c), nb, "n={n} point {}", c.point);
                 // the polygon is counter-clockwise and its edges are the faces
@@ -413,7 +417,10 @@ fn volumes_sum_to_the_domain_and_duplicates_share_cells() {
     let total: f64 = cells.iter().map(|c| c.volume).sum();
     assert!((total - lattice.volume()).abs() <= 1e-12 * lattice.volume());
     check_pairs(&cells);
-    assert_eq!(tri.voronoi_cell(20000), tri.voronoi_cell(5));
+    assert_eq!(
+        tri.voronoi_cell(InputId(20000)),
+        tri.voronoi_cell(InputId(5))
+    );
     // the lean measures are the cells' own
     let measures = tri.voronoi_measures();
     assert_eq!(measures.len(), cells.len());
@@ -425,8 +432,8 @@ fn volumes_sum_to_the_domain_and_duplicates_share_cells() {
     let edges = tri.delaunay_edges();
     assert_eq!(edges.len(), 20000 + tri.number_of_cells());
     for e in edges.iter().take(500) {
-        let a = tri.point(tri.vertex_of_input(e.i as usize));
-        let b = tri.point(tri.vertex_of_input(e.j as usize));
+        let a = tri.point(tri.vertex_of_input(e.i));
+        let b = tri.point(tri.vertex_of_input(e.j));
         let l: [f64; 3] = std::array::from_fn(|x| {
             b[x] + (0..3).map(|k| e.shift[k] as f64 * m[k][x]).sum::<f64>() - a[x]
         });
@@ -450,7 +457,7 @@ fn volumes_sum_to_the_domain_and_duplicates_share_cells() {
             .sum();
         for f in &c.faces {
             let m = lattice.vectors();
-            let q = tri.point(tri.vertex_of_input(f.neighbor as usize));
+            let q = tri.point(tri.vertex_of_input(f.neighbor));
             let l: [f64; 3] = std::array::from_fn(|x| {
                 q[x] + (0..3).map(|k| f.shift[k] as f64 * m[k][x]).sum::<f64>()
             });

@@ -7,20 +7,22 @@ use std::collections::HashMap;
 use rayon::prelude::*;
 
 use super::{Candidate, Engine};
+use crate::ids::{CellId, PointId, VertexId};
 use crate::space::OrbitSpace;
-use crate::tds::{Cell, Tds, NONE};
+use crate::tds::{Cell, Tds};
 
 impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// The vertex id of the lifted copy `(p, o)` at the current level: `sheets` ids per
     /// point, sheet by sheet (the point id itself in the quotient).
-    fn vertex_id(&self, p: u32, o: S::Elem) -> u32 {
+    fn vertex_id(&self, p: PointId, o: S::Elem) -> VertexId {
         let sheets = self.space.sheets(self.level) as u32;
-        p * sheets + self.space.sheet_of(o, self.level) as u32
+        VertexId(p.0 * sheets + self.space.sheet_of(o, self.level) as u32)
     }
 
     /// For every point `p`, the lifted copies within `radius` of it (at the identity): the
     /// copies near its image `g·p` are their images by `g`, so gift wrapping asks the
-    /// space once per point, not once per facet.
+    /// space once per point, not once per facet. (The space names a point by its index in
+    /// the slice of points it is given: its id.)
     fn copies_around(&self, radius: f64) -> Vec<Vec<(u32, S::Elem)>> {
         let one = self.space.identity();
         (0..self.points.len())
@@ -39,14 +41,14 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     fn wrap_candidates(
         &self,
         around: &[Vec<(u32, S::Elem)>],
-        p: u32,
+        p: PointId,
         g: S::Elem,
     ) -> Vec<Candidate<S, N>> {
-        around[p as usize]
+        around[p.index()]
             .iter()
             .map(|&(i, h)| {
                 let o = self.space.compose(g, h);
-                (self.vertex_id(i, o), (self.points[i as usize], o))
+                (self.vertex_id(PointId(i), o), (self.points[i as usize], o))
             })
             .collect()
     }
@@ -59,13 +61,13 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.copies = self.space.covering_copies(level);
         let sheets = self.copies.len();
         self.vpoint = (0..self.points.len() as u32)
-            .flat_map(|p| std::iter::repeat_n(p, sheets))
+            .flat_map(|p| std::iter::repeat_n(PointId(p), sheets))
             .collect();
-        self.vcell = vec![NONE; self.vpoint.len()];
+        self.vcell = vec![CellId::NONE; self.vpoint.len()];
         self.big_limit = self.next_limit();
         self.big.clear();
         self.big_count = 0;
-        self.hint = NONE;
+        self.hint = CellId::NONE;
         self.hint_shift = self.space.identity();
         self.copy_hints.clear();
     }
@@ -79,8 +81,8 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         let radius = self.space.edge_bound(level);
         let one = self.space.identity();
         let around = self.copies_around(radius);
-        let a = (self.vertex_id(0, one), (self.points[0], one));
-        let cands = self.wrap_candidates(&around, 0, one);
+        let a = (self.vertex_id(PointId(0), one), (self.points[0], one));
+        let cands = self.wrap_candidates(&around, PointId(0), one);
         let max_r2 = (radius / 2.0) * (radius / 2.0) * (1.0 + 1e-9);
         let first = self
             .first_cell(a, &cands, max_r2)
@@ -91,7 +93,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 seeds,
                 |vids, arr, idx| {
                     let k = (idx + 1) % N;
-                    self.wrap_candidates(&around, self.vpoint[vids[k] as usize], arr[k].1)
+                    self.wrap_candidates(&around, self.vpoint[vids[k].index()], arr[k].1)
                 },
                 vec![first],
                 true,
@@ -143,14 +145,14 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         if self.one_sheeted {
             return true;
         }
-        let mut seen: HashMap<(u32, u32), S::Elem> = HashMap::new();
+        let mut seen: HashMap<(PointId, PointId), S::Elem> = HashMap::new();
         for c in self.tds.ids() {
-            let cell = &self.tds.cells[c as usize];
+            let cell = &self.tds.cells[c.index()];
             for a in 0..N {
                 for b in 0..N {
                     let (pa, pb) = (
-                        self.vpoint[cell.v[a] as usize],
-                        self.vpoint[cell.v[b] as usize],
+                        self.vpoint[cell.v[a].index()],
+                        self.vpoint[cell.v[b].index()],
                     );
                     if a == b {
                         continue;
@@ -177,45 +179,46 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         }
         let old = std::mem::replace(&mut self.tds, Tds::new());
         let old_vpoint = std::mem::take(&mut self.vpoint);
-        let mut orbit = vec![NONE; old.cells.len()];
-        let mut reps: Vec<u32> = Vec::new();
-        let mut index: HashMap<[(u32, S::Elem); N], u32> = HashMap::new();
+        // the new cells are created in the order of `reps`: the `k`-th has id `k`
+        let mut orbit = vec![CellId::NONE; old.cells.len()];
+        let mut reps: Vec<CellId> = Vec::new();
+        let mut index: HashMap<[(PointId, S::Elem); N], CellId> = HashMap::new();
         for c in old.ids() {
-            let key = quotient_key(&self.space, &old_vpoint, &old.cells[c as usize], level);
-            orbit[c as usize] = *index.entry(key).or_insert_with(|| {
+            let key = quotient_key(&self.space, &old_vpoint, &old.cells[c.index()], level);
+            orbit[c.index()] = *index.entry(key).or_insert_with(|| {
                 reps.push(c);
-                (reps.len() - 1) as u32
+                CellId::new(reps.len() - 1)
             });
         }
         self.enter_level(level);
         self.tds.reserve(reps.len());
         for &c in &reps {
-            let was = &old.cells[c as usize];
+            let was = &old.cells[c.index()];
             let mut cell = Cell::new(was.v, was.off);
-            cell.n = was.n.map(|d| orbit[d as usize]);
+            cell.n = was.n.map(|d| orbit[d.index()]);
             // in the new level's canonical form, then renumbered for its sheets
             self.canonicalize(&mut cell);
-            cell.v = std::array::from_fn(|i| {
-                self.vertex_id(old_vpoint[cell.v[i] as usize], cell.off[i])
-            });
+            cell.v =
+                std::array::from_fn(|i| self.vertex_id(old_vpoint[cell.v[i].index()], cell.off[i]));
             self.add_cell(cell);
         }
         for k in 0..reps.len() as u32 {
-            self.attach(k);
+            self.attach(CellId(k));
         }
-        self.hint = 0;
+        self.hint = CellId(0);
     }
 
     /// Drops the first `k` points (the dummies, once removed) and renumbers the rest.
     pub(crate) fn drop_leading_points(&mut self, k: u32) {
         debug_assert!(self.one_sheeted);
         self.points.drain(..k as usize);
-        self.vpoint = (0..self.points.len() as u32).collect();
+        self.vpoint = (0..self.points.len() as u32).map(PointId).collect();
         self.vcell.drain(..k as usize);
         for c in 0..self.tds.cells.len() as u32 {
+            let c = CellId(c);
             if self.tds.is_alive(c) {
-                for v in self.tds.cells[c as usize].v.iter_mut() {
-                    *v -= k;
+                for v in self.tds.cells[c.index()].v.iter_mut() {
+                    *v = VertexId(v.0 - k);
                 }
             }
         }
@@ -243,14 +246,14 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
 /// space's group into normal form, then (point, offset) pairs sorted.
 pub(super) fn quotient_key<S: OrbitSpace<N>, const N: usize>(
     space: &S,
-    vpoint: &[u32],
+    vpoint: &[PointId],
     cell: &Cell<S::Elem, N>,
     level: usize,
-) -> [(u32, S::Elem); N] {
+) -> [(PointId, S::Elem); N] {
     let mut off = cell.off;
     space.normalize(&mut off, level);
-    let mut pairs: [(u32, S::Elem); N] =
-        std::array::from_fn(|i| (vpoint[cell.v[i] as usize], off[i]));
+    let mut pairs: [(PointId, S::Elem); N] =
+        std::array::from_fn(|i| (vpoint[cell.v[i].index()], off[i]));
     pairs.sort_unstable();
     pairs
 }

@@ -2,15 +2,15 @@
 //! search, and starring the hole.
 
 use super::{Engine, Inserted, LiftedOf};
+use crate::ids::{CellId, PointId, VertexId};
 use crate::predicates::Sign;
 use crate::sort::SplitMix;
 use crate::space::OrbitSpace;
-use crate::tds::NONE;
 
 /// Why a lifted point was not inserted.
 pub(crate) enum Refused {
     /// It coincides with this vertex.
-    Duplicate(u32),
+    Duplicate(VertexId),
     /// Starring its conflict region would break the quotient (1-sheeted without criterion).
     NotSimplicial,
 }
@@ -20,17 +20,17 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// Remembering stochastic walk: never step back through the facet just crossed, and try
     /// the facets in a random rotation drawn from `rng` (the walk's only state: the
     /// triangulation is only read).
-    pub fn walk(&self, q: LiftedOf<S, N>, start: u32, rng: &mut SplitMix) -> (u32, S::Elem) {
+    pub fn walk(&self, q: LiftedOf<S, N>, start: CellId, rng: &mut SplitMix) -> (CellId, S::Elem) {
         let (p, mut qo) = q;
         let mut c = start;
-        let mut prev = NONE;
+        let mut prev = CellId::NONE;
         'walk: loop {
             let r = rng.below(N);
             self.tds.prefetch_neighbours(c);
             let mut s = self.lifted_cell(c);
             for k in 0..N {
                 let i = (r + k) % N;
-                let d = self.tds.cells[c as usize].n[i];
+                let d = self.tds.cells[c.index()].n[i];
                 if d == prev {
                     continue;
                 }
@@ -51,7 +51,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     }
 
     /// [`Self::walk`] with the engine's own random generator (insertion).
-    fn locate_from(&mut self, q: LiftedOf<S, N>, start: u32) -> (u32, S::Elem) {
+    fn locate_from(&mut self, q: LiftedOf<S, N>, start: CellId) -> (CellId, S::Elem) {
         let mut rng = self.rng.clone();
         let found = self.walk(q, start, &mut rng);
         self.rng = rng;
@@ -60,14 +60,14 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
 
     /// The cell containing the point (at the identity), walking from the last insertion;
     /// it only reads the triangulation, so queries may run in parallel.
-    pub fn locate(&self, p: S::Point) -> (u32, S::Elem) {
+    pub fn locate(&self, p: S::Point) -> (CellId, S::Elem) {
         let (start, shift) = self.start_cell();
         self.walk((p, shift), start, &mut SplitMix::new(0x10ca7e))
     }
 
     /// Collects the cells whose circumsphere contains `q` (starting at `c0`, which contains
     /// `q`) and the facets bounding them.
-    fn find_conflicts(&mut self, c0: u32, q0: S::Elem, p: S::Point) {
+    fn find_conflicts(&mut self, c0: CellId, q0: S::Elem, p: S::Point) {
         let (inside, outside) = self.tds.new_visit();
         let mut scratch = std::mem::take(&mut self.scratch);
         scratch.conflict.clear();
@@ -78,7 +78,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         while next < scratch.conflict.len() {
             let (c, qo) = scratch.conflict[next];
             for i in 0..N {
-                let d = self.tds.cells[c as usize].n[i];
+                let d = self.tds.cells[c.index()].n[i];
                 let st = self.tds.stamp(d);
                 if st == inside {
                     continue;
@@ -102,7 +102,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
 
     /// Replaces the conflict region by the cone from the new vertex `x` (lifted with offset
     /// `qoff` as inserted) over its boundary.
-    fn star_hole(&mut self, x: u32, qoff: S::Elem) {
+    fn star_hole(&mut self, x: VertexId, qoff: S::Elem) {
         let mut scratch = std::mem::take(&mut self.scratch);
         let inside = self.tds.stamp(scratch.conflict[0].0);
         scratch.created.clear();
@@ -111,18 +111,18 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         for &(ci, i) in &scratch.boundary {
             let (c, qo) = scratch.conflict[ci as usize];
             let i = i as usize;
-            let cell = self.tds.cells[c as usize];
+            let cell = self.tds.cells[c.index()];
             let mut v = cell.v;
             let mut off = cell.off;
             v[i] = x;
             off[i] = qo;
             let nc = self.make_cell(v, off);
             let d = cell.n[i];
-            let j = self.tds.cells[d as usize]
+            let j = self.tds.cells[d.index()]
                 .mirror(c)
                 .expect("symmetric neighbours");
             self.link(nc, self.slot(nc, x, i), d, j);
-            self.tds.cells[c as usize].n[i] = nc;
+            self.tds.cells[c.index()].n[i] = nc;
             scratch.created.push(nc);
         }
         // 2. link the new cells around each ridge by rotating through the conflict region.
@@ -131,16 +131,16 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             let c0 = scratch.conflict[ci as usize].0;
             // slots of the new cell (the one of `x` is linked already)
             for j in 0..N {
-                if self.tds.cells[nc as usize].n[j] != NONE {
+                if self.tds.cells[nc.index()].n[j] != CellId::NONE {
                     continue;
                 }
                 let (mut u, mut w) = (
-                    self.tds.cells[c0 as usize].v[i as usize],
-                    self.tds.cells[nc as usize].v[j],
+                    self.tds.cells[c0.index()].v[i as usize],
+                    self.tds.cells[nc.index()].v[j],
                 );
                 let mut cur = c0;
                 loop {
-                    let cc = &self.tds.cells[cur as usize];
+                    let cc = &self.tds.cells[cur.index()];
                     let kw = cc.index_of(w).expect("ridge rotation");
                     let nb = cc.n[kw];
                     if self.tds.stamp(nb) != inside {
@@ -149,10 +149,10 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                         self.link(nc, j, nb, self.slot(nb, u, ku));
                         break;
                     }
-                    let m = self.tds.cells[nb as usize]
+                    let m = self.tds.cells[nb.index()]
                         .mirror(cur)
                         .expect("symmetric neighbours");
-                    let xv = self.tds.cells[nb as usize].v[m];
+                    let xv = self.tds.cells[nb.index()].v[m];
                     w = u;
                     u = xv;
                     cur = nb;
@@ -166,13 +166,11 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             self.attach(nc);
         }
         let first = scratch.created[0];
-        let k = self.tds.cells[first as usize]
+        let k = self.tds.cells[first.index()]
             .index_of(x)
             .expect("new cells hold the new vertex");
         self.hint = first;
-        self.hint_shift = self
-            .space
-            .carry(qoff, self.tds.cells[first as usize].off[k]);
+        self.hint_shift = self.space.carry(qoff, self.tds.cells[first.index()].off[k]);
         self.scratch = scratch;
     }
 
@@ -190,10 +188,10 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         {
             return false;
         }
-        let mut seen: Vec<(u32, S::Elem)> = Vec::new();
+        let mut seen: Vec<(VertexId, S::Elem)> = Vec::new();
         for &(ci, i) in &self.scratch.boundary {
             let (c, qo) = self.scratch.conflict[ci as usize];
-            let cell = &self.tds.cells[c as usize];
+            let cell = &self.tds.cells[c.index()];
             for k in (0..N).filter(|&k| k != i as usize) {
                 let rel = self.space.relative(cell.off[k], qo);
                 match seen.iter().find(|e| e.0 == cell.v[k]) {
@@ -210,7 +208,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     pub(crate) fn insert_lifted(
         &mut self,
         q: LiftedOf<S, N>,
-        x: u32,
+        x: VertexId,
         check_duplicate: bool,
     ) -> Result<(), Refused> {
         let (start, shift) = self.start_cell();
@@ -220,7 +218,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 if self.space.coincide(self.lifted(c, i), (q.0, qo)) {
                     self.hint = c;
                     self.hint_shift = self.space.carry(q.1, qo);
-                    return Err(Refused::Duplicate(self.tds.cells[c as usize].v[i]));
+                    return Err(Refused::Duplicate(self.tds.cells[c.index()].v[i]));
                 }
             }
         }
@@ -238,14 +236,15 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         if self.points.is_empty() {
             self.points.push(p);
             self.bootstrap_covering();
-            return Inserted::New(0);
+            return Inserted::New(PointId(0));
         }
-        let pi = self.points.len() as u32;
+        let pi = PointId::new(self.points.len());
         if self.one_sheeted {
             self.points.push(p);
             self.vpoint.push(pi);
-            self.vcell.push(NONE);
-            match self.insert_lifted((p, self.space.identity()), pi, true) {
+            self.vcell.push(CellId::NONE);
+            // once 1-sheeted, the vertex of a point has its id
+            match self.insert_lifted((p, self.space.identity()), VertexId(pi.0), true) {
                 Ok(()) => {
                     if !self.guaranteed && self.big_count == 0 {
                         self.set_guaranteed(true);
@@ -257,7 +256,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                     self.vpoint.pop();
                     self.vcell.pop();
                     match refused {
-                        Refused::Duplicate(v) => Inserted::Duplicate(self.vpoint[v as usize]),
+                        Refused::Duplicate(v) => Inserted::Duplicate(self.vpoint[v.index()]),
                         Refused::NotSimplicial => {
                             // the quotient would stop being a triangulation: continue in
                             // the covering space
@@ -271,18 +270,18 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             self.points.push(p);
             for k in 0..self.copies.len() {
                 let o = self.copies[k];
-                let x = self.vpoint.len() as u32;
+                let x = VertexId::new(self.vpoint.len());
                 self.vpoint.push(pi);
-                self.vcell.push(NONE);
+                self.vcell.push(CellId::NONE);
                 if let Some(&(c, v, shift)) = self.copy_hints.get(k) {
-                    if self.tds.is_alive(c) && self.tds.cells[c as usize].v == v {
+                    if self.tds.is_alive(c) && self.tds.cells[c.index()].v == v {
                         (self.hint, self.hint_shift) = (c, shift);
                     }
                 }
                 let inserted = self.insert_lifted((p, o), x, k == 0);
                 let here = (
                     self.hint,
-                    self.tds.cells[self.hint as usize].v,
+                    self.tds.cells[self.hint.index()].v,
                     self.hint_shift,
                 );
                 match self.copy_hints.get_mut(k) {
@@ -296,7 +295,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                     self.points.pop();
                     self.vpoint.pop();
                     self.vcell.pop();
-                    return Inserted::Duplicate(self.vpoint[v as usize]);
+                    return Inserted::Duplicate(self.vpoint[v.index()]);
                 }
             }
             self.descend();

@@ -12,10 +12,11 @@ mod remove;
 mod validate;
 mod wrap;
 
+use crate::ids::{CellId, PointId, VertexId};
 use crate::predicates::Sign;
 use crate::sort::SplitMix;
 use crate::space::{Lifted, OrbitSpace};
-use crate::tds::{Cell, Tds, NONE};
+use crate::tds::{Cell, Tds};
 
 pub use validate::Invalid;
 
@@ -25,17 +26,17 @@ pub type LiftedOf<S, const N: usize> =
 /// The lifted vertices of one cell.
 pub type LiftedCell<S, const N: usize> = [LiftedOf<S, N>; N];
 /// A vertex id with a lifted position.
-pub type Candidate<S, const N: usize> = (u32, LiftedOf<S, N>);
+pub type Candidate<S, const N: usize> = (VertexId, LiftedOf<S, N>);
 
 /// Reusable buffers of one insertion or removal (no allocation per point).
 #[derive(Debug)]
 struct Scratch<O> {
     /// Conflict cells with the query's offset in each cell's frame.
-    conflict: Vec<(u32, O)>,
+    conflict: Vec<(CellId, O)>,
     /// Boundary facets: (index into `conflict`, facet).
     boundary: Vec<(u32, u8)>,
     /// New cells, parallel to `boundary`.
-    created: Vec<u32>,
+    created: Vec<CellId>,
 }
 
 // (not derived: that would ask the group elements for a `Default`)
@@ -52,10 +53,10 @@ impl<O> Default for Scratch<O> {
 /// The result of inserting one point.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Inserted {
-    /// A new vertex for the point with this index.
-    New(u32),
-    /// The point coincides with the existing point of this index.
-    Duplicate(u32),
+    /// A new point (vertex of the quotient) with this id.
+    New(PointId),
+    /// The point coincides with the existing point of this id.
+    Duplicate(PointId),
 }
 
 /// A Delaunay triangulation of an orbit space.
@@ -65,9 +66,9 @@ pub struct Engine<S: OrbitSpace<N>, const N: usize> {
     /// The distinct points (dummy points, while present, at the end).
     pub(crate) points: Vec<S::Point>,
     /// Vertex → its point (1-sheeted: the identity; covering: one vertex per copy).
-    pub(crate) vpoint: Vec<u32>,
+    pub(crate) vpoint: Vec<PointId>,
     /// Vertex → one incident cell.
-    pub(crate) vcell: Vec<u32>,
+    pub(crate) vcell: Vec<CellId>,
     pub(crate) tds: Tds<S::Elem, N>,
     /// The level of the covering ladder the triangulation lives in.
     pub(crate) level: usize,
@@ -84,11 +85,11 @@ pub struct Engine<S: OrbitSpace<N>, const N: usize> {
     big_limit: f64,
     /// The offsets of one point's copies in the current covering.
     copies: Vec<S::Elem>,
-    hint: u32,
+    hint: CellId,
     /// In a covering, per copy: a cell near the last inserted point's copy, its vertices
     /// (a freed and reused slot fails the check) and the shift, so that each copy of the
     /// next point walks from its own neighbourhood instead of a period away.
-    copy_hints: Vec<(u32, [u32; N], S::Elem)>,
+    copy_hints: Vec<(CellId, [VertexId; N], S::Elem)>,
     /// Where the last inserted point sits in the hint cell's frame, relative to its own
     /// offset: the next query (spatially close) starts its walk lifted by this translation,
     /// not a period away when the hint cell straddles the domain boundary.
@@ -115,7 +116,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             guaranteed: false,
             big: Vec::new(),
             big_count: 0,
-            hint: 0,
+            hint: CellId(0),
             copy_hints: Vec::new(),
             rng: SplitMix::new(0x5eed),
             scratch: Scratch::default(),
@@ -180,42 +181,42 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     }
 
     /// Ids of the stored cells.
-    pub fn cell_ids(&self) -> impl Iterator<Item = u32> + '_ {
+    pub fn cell_ids(&self) -> impl Iterator<Item = CellId> + '_ {
         self.tds.ids()
     }
 
     /// A stored cell.
-    pub fn cell(&self, c: u32) -> &Cell<S::Elem, N> {
-        &self.tds.cells[c as usize]
+    pub fn cell(&self, c: CellId) -> &Cell<S::Elem, N> {
+        &self.tds.cells[c.index()]
     }
 
-    /// The point index of a vertex.
-    pub fn point_of(&self, v: u32) -> u32 {
-        self.vpoint[v as usize]
+    /// The point of a vertex.
+    pub fn point_of(&self, v: VertexId) -> PointId {
+        self.vpoint[v.index()]
     }
 
     /// The lifted vertex `i` of cell `c`.
     #[inline]
-    pub fn lifted(&self, c: u32, i: usize) -> LiftedOf<S, N> {
-        let cell = &self.tds.cells[c as usize];
+    pub fn lifted(&self, c: CellId, i: usize) -> LiftedOf<S, N> {
+        let cell = &self.tds.cells[c.index()];
         (self.points[self.point_index(cell.v[i])], cell.off[i])
     }
 
     /// The point of vertex `v` (the identity once 1-sheeted: no indirection on the hot path).
     #[inline(always)]
-    fn point_index(&self, v: u32) -> usize {
+    fn point_index(&self, v: VertexId) -> usize {
         if self.one_sheeted {
-            v as usize
+            v.index()
         } else {
-            self.vpoint[v as usize] as usize
+            self.vpoint[v.index()].index()
         }
     }
 
     /// All lifted vertices of cell `c`.
     #[inline(always)]
-    pub fn lifted_cell(&self, c: u32) -> LiftedCell<S, N> {
+    pub fn lifted_cell(&self, c: CellId) -> LiftedCell<S, N> {
         // (an explicit loop: `array::from_fn` and `array::map` measured 20% slower here)
-        let cell = &self.tds.cells[c as usize];
+        let cell = &self.tds.cells[c.index()];
         let mut out = [(self.points[0], cell.off[0]); N];
         for i in 0..N {
             out[i] = (self.points[self.point_index(cell.v[i])], cell.off[i]);
@@ -225,9 +226,9 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
 
     /// The offset that maps the frame of `d = neighbour(c, i)` onto the frame of `c`.
     #[inline(always)]
-    pub fn translation(&self, c: u32, i: usize, d: u32) -> S::Elem {
-        let cc = &self.tds.cells[c as usize];
-        let dc = &self.tds.cells[d as usize];
+    pub fn translation(&self, c: CellId, i: usize, d: CellId) -> S::Elem {
+        let cc = &self.tds.cells[c.index()];
+        let dc = &self.tds.cells[d.index()];
         let one = self.space.identity();
         if cc.off == [one; N] && dc.off == [one; N] {
             return one;
@@ -239,9 +240,9 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
 
     /// The cells incident to vertex `v`: (cell, index of `v` in it, shift from the cell's
     /// frame to the frame of the first cell, so that the star lifts as one piece).
-    pub fn star(&self, v: u32) -> Vec<(u32, usize, S::Elem)> {
-        let c0 = self.vcell[v as usize];
-        let i0 = self.tds.cells[c0 as usize]
+    pub fn star(&self, v: VertexId) -> Vec<(CellId, usize, S::Elem)> {
+        let c0 = self.vcell[v.index()];
+        let i0 = self.tds.cells[c0.index()]
             .index_of(v)
             .expect("vcell holds its vertex");
         let mut star = vec![(c0, i0, self.space.identity())];
@@ -249,12 +250,12 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         while next < star.len() {
             let (c, i, shift) = star[next];
             for k in (0..N).filter(|&k| k != i) {
-                let d = self.tds.cells[c as usize].n[k];
+                let d = self.tds.cells[c.index()].n[k];
                 if star.iter().any(|s| s.0 == d) {
                     continue;
                 }
                 let t = self.space.compose(shift, self.translation(c, k, d));
-                let j = self.tds.cells[d as usize]
+                let j = self.tds.cells[d.index()]
                     .index_of(v)
                     .expect("a neighbour through a facet holding v holds v");
                 star.push((d, j, t));
@@ -265,10 +266,10 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     }
 
     /// The neighbours of vertex `v`: each (vertex, its offset relative to `v`) once, sorted.
-    pub fn neighbours(&self, v: u32) -> Vec<(u32, S::Elem)> {
+    pub fn neighbours(&self, v: VertexId) -> Vec<(VertexId, S::Elem)> {
         let mut out = Vec::new();
         for (c, k, _) in self.star(v) {
-            let cell = &self.tds.cells[c as usize];
+            let cell = &self.tds.cells[c.index()];
             for j in (0..N).filter(|&j| j != k) {
                 out.push((cell.v[j], self.space.relative(cell.off[j], cell.off[k])));
             }
@@ -280,34 +281,35 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
 
     /// Gives point `p` the representative `coords`, where `coords + t·M` is its current
     /// position: every copy's star gets its offset shifted by `t`, so no cell moves.
-    pub(crate) fn move_representative(&mut self, p: u32, coords: S::Point, t: S::Elem) {
+    pub(crate) fn move_representative(&mut self, p: PointId, coords: S::Point, t: S::Elem) {
         // the point itself once 1-sheeted; its copies `p·S … p·S+S−1` in the covering
         let copies = self.space.sheets(self.level) as u32;
-        for v in p * copies..(p + 1) * copies {
-            debug_assert_eq!(self.vpoint[v as usize], p);
+        for v in p.0 * copies..(p.0 + 1) * copies {
+            let v = VertexId(v);
+            debug_assert_eq!(self.vpoint[v.index()], p);
             for (c, k, _) in self.star(v) {
-                let mut cell = self.tds.cells[c as usize];
+                let mut cell = self.tds.cells[c.index()];
                 cell.off[k] = self.space.compose(cell.off[k], t);
                 self.canonicalize(&mut cell);
-                self.tds.cells[c as usize] = cell;
+                self.tds.cells[c.index()] = cell;
             }
         }
-        self.points[p as usize] = coords;
+        self.points[p.index()] = coords;
     }
 
-    /// A vertex of point `p`: the point itself once 1-sheeted, its copy on sheet 0 (offset
-    /// zero) in the covering.
-    pub fn vertex_of_point(&self, p: u32) -> u32 {
+    /// A vertex of point `p`: the point's own id once 1-sheeted, its copy on sheet 0
+    /// (offset zero) in the covering.
+    pub fn vertex_of_point(&self, p: PointId) -> VertexId {
         if self.one_sheeted {
-            p
+            VertexId(p.0)
         } else {
             let sheets = self.space.sheets(self.level) as u32;
-            p * sheets + self.space.sheet_of(self.space.identity(), self.level) as u32
+            VertexId(p.0 * sheets + self.space.sheet_of(self.space.identity(), self.level) as u32)
         }
     }
 
     /// Exact orientation of a stored cell.
-    pub fn orientation(&self, c: u32) -> Sign {
+    pub fn orientation(&self, c: CellId) -> Sign {
         self.space.orient(&self.lifted_cell(c))
     }
 
@@ -325,11 +327,11 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// The slot of vertex `x` in cell `c`, which is `guess` unless canonicalizing the cell
     /// exchanged slots.
     #[inline(always)]
-    fn slot(&self, c: u32, x: u32, guess: usize) -> usize {
+    fn slot(&self, c: CellId, x: VertexId, guess: usize) -> usize {
         if !S::MAY_REVERSE {
             return guess;
         }
-        let cell = &self.tds.cells[c as usize];
+        let cell = &self.tds.cells[c.index()];
         if cell.v[guess] == x {
             guess
         } else {
@@ -338,14 +340,14 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     }
 
     /// Creates a cell in canonical form and keeps the criterion bookkeeping.
-    fn make_cell(&mut self, v: [u32; N], off: [S::Elem; N]) -> u32 {
+    fn make_cell(&mut self, v: [VertexId; N], off: [S::Elem; N]) -> CellId {
         let mut cell = Cell::new(v, off);
         self.canonicalize(&mut cell);
         self.add_cell(cell)
     }
 
     /// Stores a canonical cell and keeps the criterion bookkeeping.
-    fn add_cell(&mut self, cell: Cell<S::Elem, N>) -> u32 {
+    fn add_cell(&mut self, cell: Cell<S::Elem, N>) -> CellId {
         let id = self.tds.create(cell);
         if !self.guaranteed {
             self.track(id);
@@ -354,12 +356,12 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     }
 
     /// Records whether cell `c` is too large for the criterion of the next level.
-    fn track(&mut self, c: u32) {
+    fn track(&mut self, c: CellId) {
         let big = self.space.circumradius2(&self.lifted_cell(c)) >= self.big_limit;
-        if self.big.len() <= c as usize {
-            self.big.resize(c as usize + 1, false);
+        if self.big.len() <= c.index() {
+            self.big.resize(c.index() + 1, false);
         }
-        self.big[c as usize] = big;
+        self.big[c.index()] = big;
         self.big_count += big as usize;
     }
 
@@ -388,16 +390,16 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.big_limit = self.next_limit();
         self.big.clear();
         self.big_count = 0;
-        let ids: Vec<u32> = self.tds.ids().collect();
+        let ids: Vec<CellId> = self.tds.ids().collect();
         for c in ids {
             self.track(c);
         }
     }
 
     /// Deletes a cell and keeps the criterion bookkeeping.
-    fn kill_cell(&mut self, c: u32) {
-        if !self.guaranteed && self.big[c as usize] {
-            self.big[c as usize] = false;
+    fn kill_cell(&mut self, c: CellId) {
+        if !self.guaranteed && self.big[c.index()] {
+            self.big[c.index()] = false;
             self.big_count -= 1;
         }
         self.tds.delete(c);
@@ -405,25 +407,25 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
 
     /// Points `vcell` of every vertex of `c` at `c`.
     #[inline]
-    fn attach(&mut self, c: u32) {
-        let v = self.tds.cells[c as usize].v;
+    fn attach(&mut self, c: CellId) {
+        let v = self.tds.cells[c.index()].v;
         for x in v {
-            self.vcell[x as usize] = c;
+            self.vcell[x.index()] = c;
         }
     }
 
     /// Links facet `i` of `a` with facet `j` of `b`.
     #[inline]
-    fn link(&mut self, a: u32, i: usize, b: u32, j: usize) {
-        self.tds.cells[a as usize].n[i] = b;
-        self.tds.cells[b as usize].n[j] = a;
+    fn link(&mut self, a: CellId, i: usize, b: CellId, j: usize) {
+        self.tds.cells[a.index()].n[i] = b;
+        self.tds.cells[b.index()].n[j] = a;
     }
 
     /// A live cell to start a walk from, and the translation to apply to a query near the
     /// last inserted point.
-    fn start_cell(&self) -> (u32, S::Elem) {
-        if self.hint != NONE
-            && (self.hint as usize) < self.tds.cells.len()
+    fn start_cell(&self) -> (CellId, S::Elem) {
+        if self.hint != CellId::NONE
+            && self.hint.index() < self.tds.cells.len()
             && self.tds.is_alive(self.hint)
         {
             (self.hint, self.hint_shift)

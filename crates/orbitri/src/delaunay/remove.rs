@@ -3,8 +3,8 @@
 
 use super::wrap::{Owner, Wrapped};
 use super::{Candidate, Engine, LiftedCell};
+use crate::ids::{CellId, VertexId};
 use crate::space::OrbitSpace;
-use crate::tds::NONE;
 
 /// Why a removal was refused.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -18,10 +18,10 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// Removes vertex `v` of a 1-sheeted triangulation. When the new cells break the switch
     /// criterion, or it already does not hold, the removal goes ahead only if the quotient
     /// stays a simplicial complex (Theorem 2.2.8); otherwise nothing changes.
-    pub(crate) fn remove_vertex(&mut self, v: u32) -> Result<(), RemoveError> {
+    pub(crate) fn remove_vertex(&mut self, v: VertexId) -> Result<(), RemoveError> {
         debug_assert!(self.one_sheeted);
         let star = self.star(v);
-        let shifted = |e: &Self, c: u32, shift: S::Elem| -> LiftedCell<S, N> {
+        let shifted = |e: &Self, c: CellId, shift: S::Elem| -> LiftedCell<S, N> {
             e.lifted_cell(c)
                 .map(|(p, o)| (p, e.space.compose(shift, o)))
         };
@@ -29,14 +29,14 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         let mut seeds = Vec::with_capacity(star.len());
         for &(c, i, shift) in &star {
             let mut arr = shifted(self, c, shift);
-            let cell = self.tds.cells[c as usize];
+            let cell = self.tds.cells[c.index()];
             for k in 0..N {
                 if k != i && !hole.iter().any(|h| h.0 == cell.v[k]) {
                     hole.push((cell.v[k], arr[k]));
                 }
             }
             let d = cell.n[i];
-            let j = self.tds.cells[d as usize]
+            let j = self.tds.cells[d.index()]
                 .mirror(c)
                 .expect("symmetric neighbours");
             // a star cell moved by an orientation-reversing element is negatively oriented:
@@ -57,7 +57,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             .iter()
             .any(|w| self.space.circumradius2(&w.arr) >= limit);
         if breaks || !self.guaranteed {
-            let star_ids: Vec<u32> = star.iter().map(|s| s.0).collect();
+            let star_ids: Vec<CellId> = star.iter().map(|s| s.0).collect();
             if !self.removal_keeps_simplicial(&star_ids, &cells) {
                 return Err(RemoveError::NotSimplicial);
             }
@@ -67,7 +67,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             self.kill_cell(c);
         }
         self.commit(&cells);
-        self.vcell[v as usize] = NONE;
+        self.vcell[v.index()] = CellId::NONE;
         if !self.guaranteed && self.big_count == 0 {
             self.set_guaranteed(true);
         }
@@ -79,14 +79,14 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// with a single offset and never the vertex itself.
     fn removal_keeps_simplicial(
         &mut self,
-        star: &[u32],
+        star: &[CellId],
         cells: &[Wrapped<S::Point, S::Elem, N>],
     ) -> bool {
-        let mut hole: Vec<u32> = cells.iter().flat_map(|w| w.vids).collect();
+        let mut hole: Vec<VertexId> = cells.iter().flat_map(|w| w.vids).collect();
         hole.sort_unstable();
         hole.dedup();
-        let mut edges: Vec<(u32, S::Elem)> = Vec::new();
-        let mut stack: Vec<u32> = Vec::new();
+        let mut edges: Vec<(VertexId, S::Elem)> = Vec::new();
+        let mut stack: Vec<CellId> = Vec::new();
         for &a in &hole {
             edges.clear();
             for w in cells {
@@ -99,10 +99,10 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             // the old cells around `a` that stay
             let (mark, _) = self.tds.new_visit();
             stack.clear();
-            stack.push(self.vcell[a as usize]);
+            stack.push(self.vcell[a.index()]);
             self.tds.set_stamp(stack[0], mark);
             while let Some(c) = stack.pop() {
-                let cell = self.tds.cells[c as usize];
+                let cell = self.tds.cells[c.index()];
                 let i = cell.index_of(a).expect("the star of a vertex holds it");
                 for k in (0..N).filter(|&k| k != i) {
                     if !star.contains(&c) {

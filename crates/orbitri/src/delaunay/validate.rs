@@ -3,9 +3,9 @@
 //! orientation, local Delaunay property, exactly).
 
 use super::Engine;
+use crate::ids::{CellId, VertexId};
 use crate::predicates::Sign;
 use crate::space::OrbitSpace;
-use crate::tds::NONE;
 
 /// Why a triangulation is invalid.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
@@ -27,16 +27,16 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             if self.orientation(c) != Sign::Positive {
                 return bad(format!("cell {c} is not positively oriented"));
             }
-            let cell = &self.tds.cells[c as usize];
+            let cell = &self.tds.cells[c.index()];
             for i in 0..N {
                 if (i + 1..N).any(|j| cell.v[i] == cell.v[j]) {
                     return bad(format!("cell {c} repeats vertex {}", cell.v[i]));
                 }
                 let d = cell.n[i];
-                if d == NONE || !self.tds.is_alive(d) {
+                if d == CellId::NONE || !self.tds.is_alive(d) {
                     return bad(format!("cell {c} has no neighbour {i}"));
                 }
-                let dc = &self.tds.cells[d as usize];
+                let dc = &self.tds.cells[d.index()];
                 let Some(j) = dc.mirror(c) else {
                     return bad(format!("cell {d} does not know its neighbour {c}"));
                 };
@@ -69,9 +69,11 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             }
         }
         for (v, &c) in self.vcell.iter().enumerate() {
-            if c == NONE
+            if c == CellId::NONE
                 || !self.tds.is_alive(c)
-                || self.tds.cells[c as usize].index_of(v as u32).is_none()
+                || self.tds.cells[c.index()]
+                    .index_of(VertexId::new(v))
+                    .is_none()
             {
                 return bad(format!("vertex {v} has no incident cell"));
             }
@@ -81,6 +83,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         // the faces are the cells in 2D: in both, χ = V − E + C. Edges are counted from each vertex's star, towards larger ids (in
         // the covering, ids are unique per copy, so an edge is one (vertex, vertex) pair).
         let edges: usize = (0..self.vcell.len() as u32)
+            .map(VertexId)
             .map(|v| self.neighbours(v).iter().filter(|w| w.0 > v).count())
             .sum();
         let counts = [self.vcell.len(), edges, self.tds.len()];
@@ -117,7 +120,7 @@ mod tests {
     fn detects_a_negatively_oriented_cell() {
         let mut e = engine();
         let c = e.tds.ids().next().unwrap();
-        let cell = &mut e.tds.cells[c as usize];
+        let cell = &mut e.tds.cells[c.index()];
         cell.v.swap(0, 1);
         cell.n.swap(0, 1);
         cell.off.swap(0, 1);
@@ -129,18 +132,18 @@ mod tests {
     fn detects_broken_neighbours_and_offsets() {
         let mut e = engine();
         let c = e.tds.ids().next().unwrap();
-        let d = e.tds.cells[c as usize].n[0];
-        let j = e.tds.cells[d as usize].mirror(c).unwrap();
-        e.tds.cells[d as usize].n[j] = e.tds.cells[d as usize].n[(j + 1) % 4];
+        let d = e.tds.cells[c.index()].n[0];
+        let j = e.tds.cells[d.index()].mirror(c).unwrap();
+        e.tds.cells[d.index()].n[j] = e.tds.cells[d.index()].n[(j + 1) % 4];
         assert!(e.is_valid().is_err());
 
         let mut e = engine();
         let c = e
             .tds
             .ids()
-            .find(|&c| e.tds.cells[c as usize].off.iter().all(|o| *o == [0; 3]))
+            .find(|&c| e.tds.cells[c.index()].off.iter().all(|o| *o == [0; 3]))
             .unwrap();
-        e.tds.cells[c as usize].off[2] = [1, 0, 0];
+        e.tds.cells[c.index()].off[2] = [1, 0, 0];
         assert!(e.is_valid().is_err());
     }
 

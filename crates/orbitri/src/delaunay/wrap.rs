@@ -6,18 +6,18 @@
 use std::collections::HashMap;
 
 use super::{Candidate, Engine, LiftedCell};
+use crate::ids::{CellId, VertexId};
 use crate::predicates::Sign;
 use crate::space::{Lifted, OrbitSpace};
-use crate::tds::NONE;
 
 /// A facet to close: vertex ids, lifted simplex, slot of the apex, side, owner.
-pub(super) type Seed<S, const N: usize> = ([u32; N], LiftedCell<S, N>, usize, bool, Owner);
+pub(super) type Seed<S, const N: usize> = ([VertexId; N], LiftedCell<S, N>, usize, bool, Owner);
 
 /// Who is on the other side of an open facet.
 #[derive(Clone, Copy, Debug)]
 pub(super) enum Owner {
     /// An existing cell and its facet index.
-    Old(u32, usize),
+    Old(CellId, usize),
     /// A new cell (index into the result) and its facet index.
     New(usize, usize),
 }
@@ -25,7 +25,7 @@ pub(super) enum Owner {
 /// A facet waiting for its cell: the lifted simplex `arr` whose slot `idx` is to be
 /// replaced by the apex, on the side of `arr[idx]` when `toward`, else on the other side.
 struct Open<P, O, const N: usize> {
-    vids: [u32; N],
+    vids: [VertexId; N],
     arr: [Lifted<P, O>; N],
     idx: usize,
     toward: bool,
@@ -35,14 +35,14 @@ struct Open<P, O, const N: usize> {
 /// A cell produced by wrapping, in the common frame of the candidates.
 #[derive(Clone, Debug)]
 pub(super) struct Wrapped<P, O, const N: usize> {
-    pub vids: [u32; N],
+    pub vids: [VertexId; N],
     pub arr: [Lifted<P, O>; N],
     pub links: [Option<Owner>; N],
 }
 
-fn facet_key<const N: usize>(vids: &[u32; N], skip: usize) -> [u32; N] {
+fn facet_key<const N: usize>(vids: &[VertexId; N], skip: usize) -> [VertexId; N] {
     let mut k = *vids;
-    k[skip] = NONE;
+    k[skip] = VertexId::NONE;
     k.sort_unstable();
     k
 }
@@ -53,13 +53,13 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         &self,
         f: &Open<S::Point, S::Elem, N>,
         cands: &[Candidate<S, N>],
-    ) -> Option<(u32, LiftedCell<S, N>)> {
+    ) -> Option<(VertexId, LiftedCell<S, N>)> {
         let want = if f.toward {
             Sign::Positive
         } else {
             Sign::Negative
         };
-        let mut best: Option<(u32, LiftedCell<S, N>)> = None;
+        let mut best: Option<(VertexId, LiftedCell<S, N>)> = None;
         for &(vid, y) in cands {
             if f.vids
                 .iter()
@@ -94,12 +94,12 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     pub(super) fn wrap(
         &self,
         seeds: Vec<Seed<S, N>>,
-        mut candidates: impl FnMut(&[u32; N], &LiftedCell<S, N>, usize) -> Vec<Candidate<S, N>>,
+        mut candidates: impl FnMut(&[VertexId; N], &LiftedCell<S, N>, usize) -> Vec<Candidate<S, N>>,
         mut first: Vec<Wrapped<S::Point, S::Elem, N>>,
         recenter: bool,
     ) -> Option<Vec<Wrapped<S::Point, S::Elem, N>>> {
-        let mut open: HashMap<[u32; N], Open<S::Point, S::Elem, N>> = HashMap::new();
-        let mut queue: Vec<[u32; N]> = Vec::new();
+        let mut open: HashMap<[VertexId; N], Open<S::Point, S::Elem, N>> = HashMap::new();
+        let mut queue: Vec<[VertexId; N]> = Vec::new();
         for (vids, arr, idx, toward, owner) in seeds {
             let key = facet_key(&vids, idx);
             queue.push(key);
@@ -173,8 +173,8 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     }
 
     /// Creates the wrapped cells and links them; returns their ids.
-    pub(super) fn commit(&mut self, cells: &[Wrapped<S::Point, S::Elem, N>]) -> Vec<u32> {
-        let ids: Vec<u32> = cells
+    pub(super) fn commit(&mut self, cells: &[Wrapped<S::Point, S::Elem, N>]) -> Vec<CellId> {
+        let ids: Vec<CellId> = cells
             .iter()
             .map(|w| self.make_cell(w.vids, w.arr.map(|(_, o)| o)))
             .collect();

@@ -7,6 +7,7 @@ use std::fmt::Write as _;
 use std::io::Write;
 
 use crate::error::{Error, Result};
+use crate::ids::InputId;
 use crate::space::{FlatManifold, FlatSpace, FlatTorus, Lattice, Motion};
 use crate::triangulation::Triangulation;
 
@@ -340,7 +341,7 @@ fn glide_columns_reflect_and_stay_in_their_tiles() {
 
 /// The Delaunay edges (one per orbit) as segments from the library's edge list.
 fn delaunay_edges<S: Drawable>(page: &Page, tri: &Triangulation<2, 3, S>) -> Vec<Shape> {
-    let at = |i: u32| tri.point(tri.vertex_of_input(i as usize));
+    let at = |i: InputId| tri.point(tri.vertex_of_input(i));
     tri.delaunay_edges()
         .into_iter()
         .map(|e| page.shape(vec![at(e.i), tri.space().apply(e.shift, at(e.j))]))

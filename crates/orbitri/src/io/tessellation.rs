@@ -9,6 +9,7 @@ use std::io::Write;
 use super::format::SpaceFormat;
 use super::npy::encode_npy_matrix;
 use super::write::{json_f64, json_point};
+use crate::ids::InputId;
 use crate::space::FlatSpace;
 use crate::triangulation::Triangulation;
 use crate::voronoi::{CellMeasures, VoronoiCell};
@@ -29,7 +30,7 @@ pub fn point_table<const D: usize, const N: usize, S: FlatSpace<D, N>>(
     tri: &Triangulation<D, N, S>,
     cells: &[CellMeasures<D>],
 ) -> PointTable {
-    let by_point: HashMap<u32, &CellMeasures<D>> = cells.iter().map(|c| (c.point, c)).collect();
+    let by_point: HashMap<InputId, &CellMeasures<D>> = cells.iter().map(|c| (c.point, c)).collect();
     let first = tri.first_occurrences();
     let mut columns: Vec<String> = ["id", "volume", "neighbours", "surface_area"]
         .iter()
@@ -42,10 +43,10 @@ pub fn point_table<const D: usize, const N: usize, S: FlatSpace<D, N>>(
             let c = by_point[&first[i]];
             let mut row = vec![i as f64, c.volume, c.faces as f64, c.surface_area];
             row.extend_from_slice(&c.centroid);
-            row.push(if first[i] as usize == i {
+            row.push(if first[i].index() == i {
                 -1.0
             } else {
-                first[i] as f64
+                f64::from(first[i].0)
             });
             row
         })
@@ -108,7 +109,7 @@ pub fn write_neighbors_csv<const D: usize, const N: usize, S: SpaceFormat<D, N>>
 fn write_pairs_csv<const D: usize, const N: usize, S: SpaceFormat<D, N>>(
     w: &mut impl Write,
     value: &str,
-    rows: impl Iterator<Item = (u32, u32, S::Elem, f64)>,
+    rows: impl Iterator<Item = (InputId, InputId, S::Elem, f64)>,
 ) -> std::io::Result<()> {
     writeln!(w, "i,j,{},{value}", S::element_columns().join(","))?;
     for (i, j, g, x) in rows {
@@ -271,7 +272,7 @@ pub fn write_voronoi_vtu<const D: usize, E>(
     for c in cells {
         let base = v.points.len() as u64;
         v.points.extend(c.vertices.iter().map(pad));
-        pid.extend(std::iter::repeat_n(c.point as f64, c.vertices.len()));
+        pid.extend(std::iter::repeat_n(f64::from(c.point.0), c.vertices.len()));
         v.connectivity
             .extend((0..c.vertices.len() as u64).map(|k| base + k));
         v.offsets.push(v.connectivity.len() as u64);
@@ -286,7 +287,7 @@ pub fn write_voronoi_vtu<const D: usize, E>(
             }
             v.face_offsets.push(v.faces.len() as u64);
         }
-        ids.push(c.point as f64);
+        ids.push(f64::from(c.point.0));
         vol.push(c.volume);
     }
     v.point_data.push(("id", pid));
@@ -304,14 +305,14 @@ pub fn write_delaunay_vtu<const D: usize, const N: usize, S: FlatSpace<D, N>>(
     tri: &Triangulation<D, N, S>,
 ) -> std::io::Result<()> {
     let mut v = Vtu::default();
-    let mut index: HashMap<(u32, S::Elem), u64> = HashMap::new();
+    let mut index: HashMap<(InputId, S::Elem), u64> = HashMap::new();
     let mut pid = Vec::new();
     for c in tri.cells(Copies::Unique) {
         for k in 0..N {
             let key = (c.vertices[k], c.offsets[k]);
             let id = *index.entry(key).or_insert_with(|| {
                 v.points.push(pad(&tri.position(key.0, key.1)));
-                pid.push(key.0 as f64);
+                pid.push(f64::from(key.0 .0));
                 v.points.len() as u64 - 1
             });
             v.connectivity.push(id);

@@ -3,6 +3,7 @@
 use std::io::Write;
 
 use super::format::SpaceFormat;
+use crate::ids::InputId;
 use crate::triangulation::Triangulation;
 
 /// The `cells` format: `SHEETS V C`, then per stored cell its `D + 1` input ids and their
@@ -28,7 +29,7 @@ pub fn write_cells<const D: usize, const N: usize, S: SpaceFormat<D, N>>(
     for c in tri.stored_cells() {
         line.clear();
         for v in c.vertices {
-            line.extend_from_slice(num.format(v).as_bytes());
+            line.extend_from_slice(num.format(v.0).as_bytes());
             line.push(b' ');
         }
         for x in c.offsets.into_iter().flat_map(S::element_integers) {
@@ -86,7 +87,8 @@ pub fn write_json<const D: usize, const N: usize, S: SpaceFormat<D, N>>(
     )?;
     write_list(
         w,
-        (0..tri.number_of_input_points()).map(|i| json_point(&tri.point(tri.vertex_of_input(i)))),
+        (0..tri.number_of_input_points())
+            .map(|i| json_point(&tri.point(tri.vertex_of_input(InputId::new(i))))),
     )?;
     write!(w, "],\"first_occurrence\":[")?;
     write_list(w, tri.first_occurrences().iter().map(|x| x.to_string()))?;
@@ -94,7 +96,7 @@ pub fn write_json<const D: usize, const N: usize, S: SpaceFormat<D, N>>(
     write_list(
         w,
         tri.stored_cells()
-            .map(|c| format!("{:?}", c.vertices).replace(' ', "")),
+            .map(|c| format!("{:?}", c.vertices.map(u32::from)).replace(' ', "")),
     )?;
     write!(w, "],\"{}\":[", S::CELL_ELEMENTS)?;
     write_list(

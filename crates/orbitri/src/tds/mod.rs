@@ -1,26 +1,25 @@
 //! The combinatorial simplicial complex: cells of `N` vertices with their `N` neighbours
-//! (neighbour `i` is opposite vertex `i`) and one group element per vertex, `u32` ids, a free
+//! (neighbour `i` is opposite vertex `i`) and one group element per vertex, typed ids, a free
 //! list, and generation stamps for visits.
 
-/// Marks a missing id.
-pub const NONE: u32 = u32::MAX;
+pub use crate::ids::{CellId, VertexId};
 
 /// A cell: vertex ids, neighbour ids, the offset of each vertex, and a visit stamp (kept
 /// in the cell so that a visit touches one cache line).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Cell<O, const N: usize> {
-    pub v: [u32; N],
-    pub n: [u32; N],
+    pub v: [VertexId; N],
+    pub n: [CellId; N],
     pub off: [O; N],
     stamp: u32,
 }
 
 impl<O: Copy, const N: usize> Cell<O, N> {
     /// A cell with no neighbours yet.
-    pub fn new(v: [u32; N], off: [O; N]) -> Self {
+    pub fn new(v: [VertexId; N], off: [O; N]) -> Self {
         Cell {
             v,
-            n: [NONE; N],
+            n: [CellId::NONE; N],
             off,
             stamp: 0,
         }
@@ -28,7 +27,7 @@ impl<O: Copy, const N: usize> Cell<O, N> {
 
     /// Index of vertex `x` in this cell.
     #[inline]
-    pub fn index_of(&self, x: u32) -> Option<usize> {
+    pub fn index_of(&self, x: VertexId) -> Option<usize> {
         self.v.iter().position(|&v| v == x)
     }
 
@@ -43,7 +42,7 @@ impl<O: Copy, const N: usize> Cell<O, N> {
 
     /// Index of neighbour `c` in this cell.
     #[inline]
-    pub fn mirror(&self, c: u32) -> Option<usize> {
+    pub fn mirror(&self, c: CellId) -> Option<usize> {
         self.n.iter().position(|&n| n == c)
     }
 }
@@ -52,7 +51,7 @@ impl<O: Copy, const N: usize> Cell<O, N> {
 #[derive(Clone, Debug, Default)]
 pub struct Tds<O, const N: usize> {
     pub cells: Vec<Cell<O, N>>,
-    free: Vec<u32>,
+    free: Vec<CellId>,
     generation: u32,
 }
 
@@ -68,29 +67,29 @@ impl<O: Copy, const N: usize> Tds<O, N> {
 
     /// Adds a cell, reusing a free slot when there is one.
     #[inline]
-    pub fn create(&mut self, c: Cell<O, N>) -> u32 {
+    pub fn create(&mut self, c: Cell<O, N>) -> CellId {
         if let Some(id) = self.free.pop() {
             // keep the old stamp: it belongs to an earlier visit
-            let stamp = self.cells[id as usize].stamp;
-            self.cells[id as usize] = Cell { stamp, ..c };
+            let stamp = self.cells[id.index()].stamp;
+            self.cells[id.index()] = Cell { stamp, ..c };
             id
         } else {
             self.cells.push(c);
-            (self.cells.len() - 1) as u32
+            CellId::new(self.cells.len() - 1)
         }
     }
 
     /// Removes a cell (its slot goes to the free list).
     #[inline]
-    pub fn delete(&mut self, id: u32) {
-        self.cells[id as usize].v[0] = NONE;
+    pub fn delete(&mut self, id: CellId) {
+        self.cells[id.index()].v[0] = VertexId::NONE;
         self.free.push(id);
     }
 
     /// True if the slot holds a live cell.
     #[inline]
-    pub fn is_alive(&self, id: u32) -> bool {
-        self.cells[id as usize].v[0] != NONE
+    pub fn is_alive(&self, id: CellId) -> bool {
+        self.cells[id.index()].v[0] != VertexId::NONE
     }
 
     /// Number of live cells.
@@ -104,8 +103,10 @@ impl<O: Copy, const N: usize> Tds<O, N> {
     }
 
     /// Ids of the live cells.
-    pub fn ids(&self) -> impl Iterator<Item = u32> + '_ {
-        (0..self.cells.len() as u32).filter(|&i| self.is_alive(i))
+    pub fn ids(&self) -> impl Iterator<Item = CellId> + '_ {
+        (0..self.cells.len() as u32)
+            .map(CellId)
+            .filter(|&i| self.is_alive(i))
     }
 
     /// Starts a new visit and returns two fresh stamp values (for "in" and "out").
@@ -122,10 +123,10 @@ impl<O: Copy, const N: usize> Tds<O, N> {
     /// Asks the processor to start loading the neighbours of `c`: the conflict search and
     /// the walk visit them next, and overlapping their cache misses saves more than it costs.
     #[inline(always)]
-    pub fn prefetch_neighbours(&self, c: u32) {
+    pub fn prefetch_neighbours(&self, c: CellId) {
         #[cfg(target_arch = "x86_64")]
-        for &d in &self.cells[c as usize].n {
-            if let Some(cell) = self.cells.get(d as usize) {
+        for &d in &self.cells[c.index()].n {
+            if let Some(cell) = self.cells.get(d.index()) {
                 // SAFETY: prefetching is only a hint; the pointer comes from a live reference.
                 unsafe {
                     std::arch::x86_64::_mm_prefetch(
@@ -139,14 +140,14 @@ impl<O: Copy, const N: usize> Tds<O, N> {
 
     /// The stamp of a cell.
     #[inline]
-    pub fn stamp(&self, id: u32) -> u32 {
-        self.cells[id as usize].stamp
+    pub fn stamp(&self, id: CellId) -> u32 {
+        self.cells[id.index()].stamp
     }
 
     /// Sets the stamp of a cell.
     #[inline]
-    pub fn set_stamp(&mut self, id: u32, s: u32) {
-        self.cells[id as usize].stamp = s;
+    pub fn set_stamp(&mut self, id: CellId, s: u32) {
+        self.cells[id.index()].stamp = s;
     }
 
     /// Drops every cell.
@@ -166,21 +167,27 @@ mod tests {
     use super::*;
 
     #[test]
+    fn typed_ids_keep_a_cell_in_48_bytes() {
+        assert_eq!(std::mem::size_of::<Cell<[i8; 3], 4>>(), 48);
+    }
+
+    #[test]
     fn create_delete_reuse() {
         let mut t: Tds<u8, 3> = Tds::new();
-        let a = t.create(Cell::new([0, 1, 2], [0; 3]));
-        let b = t.create(Cell::new([1, 2, 3], [0; 3]));
+        let vs = |v: [u32; 3]| v.map(VertexId);
+        let a = t.create(Cell::new(vs([0, 1, 2]), [0; 3]));
+        let b = t.create(Cell::new(vs([1, 2, 3]), [0; 3]));
         assert_eq!(t.len(), 2);
         t.delete(a);
         assert!(!t.is_alive(a) && t.is_alive(b));
         assert_eq!(t.ids().collect::<Vec<_>>(), vec![b]);
-        let c = t.create(Cell::new([4, 5, 6], [0; 3]));
+        let c = t.create(Cell::new(vs([4, 5, 6]), [0; 3]));
         assert_eq!(c, a);
-        assert_eq!(t.cells[c as usize].index_of(5), Some(1));
+        assert_eq!(t.cells[c.index()].index_of(VertexId(5)), Some(1));
         let (i, o) = t.new_visit();
         assert_ne!(i, o);
         t.set_stamp(b, i);
         assert_eq!(t.stamp(b), i);
-        assert_eq!(t.cells[b as usize].mirror(NONE), Some(0));
+        assert_eq!(t.cells[b.index()].mirror(CellId::NONE), Some(0));
     }
 }

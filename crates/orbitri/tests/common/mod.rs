@@ -6,7 +6,7 @@ pub mod universal;
 use std::collections::HashMap;
 
 use orbitri::sort::SplitMix;
-use orbitri::{CellView, Copies, PeriodicDelaunay3};
+use orbitri::{CellView, Copies, InputId, PeriodicDelaunay3};
 
 pub fn uniform(n: usize, seed: u64, scale: [f64; 3]) -> Vec<[f64; 3]> {
     let mut r = SplitMix::new(seed);
@@ -81,12 +81,12 @@ pub fn brute_force_check(tri: &PeriodicDelaunay3, input: &[[f64; 3]]) {
     let sheets = tri.sheets() as f64;
     let cells = tri.cells(Copies::Stored);
     let pts: Vec<[f64; 3]> = (0..input.len())
-        .map(|i| tri.point(tri.vertex_of_input(i)))
+        .map(|i| tri.point(tri.vertex_of_input(InputId::new(i))))
         .collect();
     let mut total = 0.0;
     for c in &cells {
         let p: [[f64; 3]; 4] =
-            std::array::from_fn(|i| lift(&pts[c.vertices[i] as usize], &c.offsets[i], &m));
+            std::array::from_fn(|i| lift(&pts[c.vertices[i].index()], &c.offsets[i], &m));
         let v = det(sub(p[1], p[0]), sub(p[2], p[0]), sub(p[3], p[0])) / 6.0;
         // slivers of rounded grid points can be thinner than f64 resolves; the exact
         // orientation is checked by `is_valid`, the volume sum below catches overlaps
@@ -98,10 +98,10 @@ pub fn brute_force_check(tri: &PeriodicDelaunay3, input: &[[f64; 3]]) {
         "volumes sum to {total}, expected {}",
         sheets * vol_dom
     );
-    let mut facets: HashMap<Vec<(u32, [i8; 3])>, usize> = HashMap::new();
+    let mut facets: HashMap<Vec<(InputId, [i8; 3])>, usize> = HashMap::new();
     for c in &cells {
         for skip in 0..4 {
-            let mut f: Vec<(u32, [i8; 3])> = (0..4)
+            let mut f: Vec<(InputId, [i8; 3])> = (0..4)
                 .filter(|&i| i != skip)
                 .map(|i| (c.vertices[i], c.offsets[i]))
                 .collect();
@@ -120,11 +120,11 @@ pub fn brute_force_check(tri: &PeriodicDelaunay3, input: &[[f64; 3]]) {
     // distinct input points (first occurrences) only
     let firsts: Vec<usize> = {
         let fo = tri.first_occurrences();
-        (0..input.len()).filter(|&i| fo[i] as usize == i).collect()
+        (0..input.len()).filter(|&i| fo[i].index() == i).collect()
     };
     for c in &cells {
         let p: [[f64; 3]; 4] =
-            std::array::from_fn(|i| lift(&pts[c.vertices[i] as usize], &c.offsets[i], &m));
+            std::array::from_fn(|i| lift(&pts[c.vertices[i].index()], &c.offsets[i], &m));
         // a sliver's circumcenter is not computable in f64; its emptiness is left to the
         // exact check of `is_valid`
         let l2 = (0..4)
@@ -152,7 +152,7 @@ pub fn brute_force_check(tri: &PeriodicDelaunay3, input: &[[f64; 3]]) {
                 for y in lo[1]..=hi[1] {
                     for w in lo[2]..=hi[2] {
                         let o = [x as i8, y as i8, w as i8];
-                        if (0..4).any(|k| c.vertices[k] as usize == i && c.offsets[k] == o) {
+                        if (0..4).any(|k| c.vertices[k].index() == i && c.offsets[k] == o) {
                             continue;
                         }
                         let l = lift(&q, &o, &m);
@@ -171,7 +171,7 @@ pub fn canonical_cells(cells: &[CellView]) -> Vec<[i64; 16]> {
     let mut out: Vec<[i64; 16]> = cells
         .iter()
         .map(|c| {
-            let mut pairs: Vec<(u32, [i8; 3])> =
+            let mut pairs: Vec<(InputId, [i8; 3])> =
                 (0..4).map(|i| (c.vertices[i], c.offsets[i])).collect();
             pairs.sort_unstable();
             for k in 0..3 {
@@ -180,7 +180,7 @@ pub fn canonical_cells(cells: &[CellView]) -> Vec<[i64; 16]> {
             }
             let mut line = [0i64; 16];
             for (i, (v, o)) in pairs.iter().enumerate() {
-                line[i] = *v as i64;
+                line[i] = i64::from(v.0);
                 for k in 0..3 {
                     line[4 + 3 * i + k] = o[k] as i64;
                 }

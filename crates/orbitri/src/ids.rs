@@ -1,0 +1,124 @@
+//! Typed ids: one type per kind of index, so that the compiler refuses to use one where
+//! another is meant. Each is a `u32` underneath (`#[repr(transparent)]`, zero-cost); `index`
+//! gives the `usize` to index a store with, `NONE` (`u32::MAX`) marks an unset slot.
+//!
+//! - [`CellId`]: a slot of the engine's cell store.
+//! - [`VertexId`]: a vertex of the stored triangulation; in a covering space each point has
+//!   one vertex per sheet, in the 1-sheeted quotient the vertex of a point has its id.
+//! - [`PointId`]: a distinct point, in the engine's order of insertion (the facade's
+//!   "vertex": duplicates share one).
+//! - [`InputId`]: the position of a point among all the points given, in the order given
+//!   (what the output lists, the writers and the Python bindings call an id).
+
+use std::fmt;
+use std::hash::{Hash, Hasher};
+
+macro_rules! id {
+    ($(#[$doc:meta])* $name:ident) => {
+        $(#[$doc])*
+        #[repr(transparent)]
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+        pub struct $name(pub u32);
+
+        impl $name {
+            /// Marks a missing id.
+            pub const NONE: Self = $name(u32::MAX);
+
+            /// The id of index `i`, which must fit in a `u32`.
+            #[inline(always)]
+            pub const fn new(i: usize) -> Self {
+                debug_assert!(i <= u32::MAX as usize);
+                $name(i as u32)
+            }
+
+            /// The id as an index.
+            #[inline(always)]
+            pub const fn index(self) -> usize {
+                self.0 as usize
+            }
+        }
+
+        /// Hashes as its number; a slice of ids as one slice of numbers (a derived `Hash`
+        /// would write them one by one: the gift wrapping's facet keys are arrays of ids).
+        impl Hash for $name {
+            #[inline]
+            fn hash<H: Hasher>(&self, state: &mut H) {
+                self.0.hash(state)
+            }
+
+            #[inline]
+            fn hash_slice<H: Hasher>(data: &[Self], state: &mut H) {
+                // SAFETY: `#[repr(transparent)]` over `u32`: the ids are `u32`s in memory.
+                let raw =
+                    unsafe { std::slice::from_raw_parts(data.as_ptr().cast::<u32>(), data.len()) };
+                u32::hash_slice(raw, state)
+            }
+        }
+
+        impl From<u32> for $name {
+            #[inline(always)]
+            fn from(i: u32) -> Self {
+                $name(i)
+            }
+        }
+
+        impl From<$name> for u32 {
+            #[inline(always)]
+            fn from(id: $name) -> u32 {
+                id.0
+            }
+        }
+
+        /// The plain number, as the writers print ids.
+        impl fmt::Display for $name {
+            fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                fmt::Display::fmt(&self.0, f)
+            }
+        }
+    };
+}
+
+id!(
+    /// A slot of the cell store ([`crate::tds::Tds`]); `NONE` is "no neighbour".
+    CellId
+);
+id!(
+    /// A vertex of the stored triangulation: in a covering space, one per copy of a point
+    /// (see [`crate::Engine::point_of`]); in the 1-sheeted quotient, the point's own id.
+    VertexId
+);
+id!(
+    /// A distinct point, indexing the engine's points: a vertex of the quotient.
+    PointId
+);
+id!(
+    /// The position of a point among all the points given to a triangulation, in the order
+    /// given; duplicates are listed by the id of their first occurrence.
+    InputId
+);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ids_are_their_numbers() {
+        assert_eq!(std::mem::size_of::<[CellId; 4]>(), 16);
+        assert_eq!(CellId::NONE.0, u32::MAX);
+        assert_eq!(VertexId::new(7).index(), 7);
+        assert_eq!(u32::from(InputId::from(3)), 3);
+        assert_eq!(format!("{}", PointId(12)), "12");
+        assert!(InputId(2) < InputId(10));
+        let hash = |x: &dyn Fn(&mut std::hash::DefaultHasher)| {
+            let mut h = std::hash::DefaultHasher::new();
+            x(&mut h);
+            h.finish()
+        };
+        let ids = [VertexId(3), VertexId(u32::MAX), VertexId(7)];
+        assert_eq!(
+            hash(&|h| ids.hash(h)),
+            hash(&|h| [3u32, u32::MAX, 7].hash(h))
+        );
+        assert_eq!(hash(&|h| CellId(9).hash(h)), hash(&|h| 9u32.hash(h)));
+    }
+}
