@@ -43,6 +43,9 @@ pub enum Error {
         #[source]
         source: std::io::Error,
     },
+    /// An input id the triangulation does not hold: never given, or removed.
+    #[error("input id {id}: {why}")]
+    UnknownInput { id: u64, why: String },
     /// The caller's progress or interrupt callback asked a long computation to stop.
     #[error("interrupted")]
     Interrupted,

@@ -7,7 +7,7 @@
 use std::collections::HashSet;
 use std::ops::ControlFlow;
 
-use crate::delaunay::{Engine, Inserted, Invalid};
+use crate::delaunay::{Engine, Inserted, Invalid, Removal};
 use crate::error::{Error, Result};
 use crate::ids::{CellId, InputId, PointId, VertexId};
 use crate::space::{FlatManifold, FlatSpace, FlatTorus, OrbitSpace};
@@ -99,6 +99,8 @@ pub struct Triangulation<const D: usize, const N: usize, S: FlatSpace<D, N> = Fl
     wrapped: usize,
     duplicates: usize,
     used_dummies: bool,
+    /// Removals that had to triangulate the remaining points again (see [`Removal`]).
+    rebuilds: usize,
 }
 
 /// The periodic Delaunay triangulation of a flat torus of dimension `D`.
@@ -178,6 +180,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             wrapped: 0,
             duplicates: 0,
             used_dummies: false,
+            rebuilds: 0,
         }
     }
 
@@ -384,6 +387,116 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         Ok(out)
     }
 
+    /// Removes input point `i`: afterwards the triangulation is the Delaunay triangulation
+    /// of the remaining points, equal cell for cell to a fresh build of them (whenever both
+    /// are in the same space, see [`Self::sheets`]). When other input ids are duplicates of
+    /// `i`'s point, the point stays, with its coordinates, and the least of those ids becomes
+    /// its first occurrence. Other input ids never change; point ids do (the last point
+    /// takes the removed one's). An id never given or already removed is an error that
+    /// changes nothing.
+    ///
+    /// ```
+    /// use orbitri::{FlatTorus3, InputId, PeriodicDelaunay3};
+    /// let pts: Vec<[f64; 3]> = (0..200)
+    ///     .map(|i| {
+    ///         let f = i as f64;
+    ///         [(f * 0.618034) % 1.0, (f * 0.414214) % 1.0, (f * 0.732051) % 1.0]
+    ///     })
+    ///     .collect();
+    /// let torus = FlatTorus3::cuboid([1.0; 3]).unwrap();
+    /// let mut tri = PeriodicDelaunay3::build(torus.clone(), &pts).unwrap();
+    /// tri.remove(InputId(7)).unwrap();
+    /// assert!(tri.remove(InputId(7)).is_err());
+    /// assert_eq!(tri.number_of_vertices(), 199);
+    /// assert!(tri.is_valid().is_ok());
+    /// ```
+    pub fn remove(&mut self, i: InputId) -> Result<Removal> {
+        let p = self.live_point(i)?;
+        self.input_point[i.index()] = PointId::NONE;
+        if self.detach_duplicate(i, p) {
+            return Ok(Removal::InPlace);
+        }
+        let last = PointId(self.point_input.len() as u32 - 1);
+        let how = self.engine.remove_point(p);
+        self.rebuilds += (how == Removal::Rebuilt) as usize;
+        // the engine moved the last point into `p`'s slot
+        self.point_input.swap_remove(p.index());
+        if p != last {
+            if self.duplicates == 0 {
+                self.input_point[self.point_input[p.index()].index()] = p;
+            } else {
+                for x in self.input_point.iter_mut().filter(|x| **x == last) {
+                    *x = p;
+                }
+            }
+        }
+        Ok(how)
+    }
+
+    /// Moves input point `i` to `to`, keeping its id. A move that leaves the cells around
+    /// it positively oriented and Delaunay changes its coordinates alone and returns true;
+    /// otherwise the point is removed and inserted again (false). A move onto another
+    /// point makes `i` its duplicate, as an insertion does. A non-finite coordinate or an
+    /// unknown id is an error that changes nothing.
+    pub fn move_point(&mut self, i: InputId, to: [f64; D]) -> Result<bool> {
+        let p = self.live_point(i)?;
+        let (w, _) = internal_point(self.space(), i.index(), &to)?;
+        let shared = self.duplicates > 0
+            && self
+                .input_point
+                .iter()
+                .enumerate()
+                .any(|(j, &x)| x == p && j != i.index());
+        if !shared && self.engine.try_move(p, w) {
+            return Ok(true);
+        }
+        self.remove(i)?;
+        if let Inserted::Duplicate(q) = self.insert_wrapped(i, w) {
+            if self.point_input[q.index()] == i {
+                self.represent(q, w);
+            }
+        }
+        Ok(false)
+    }
+
+    /// The point of a live input id, or the error naming it.
+    fn live_point(&self, i: InputId) -> Result<PointId> {
+        let unknown = |why: String| Error::UnknownInput {
+            id: i.0 as u64,
+            why,
+        };
+        match self.input_point.get(i.index()) {
+            None => Err(unknown(format!(
+                "out of range ({} input points were given)",
+                self.input_point.len()
+            ))),
+            Some(&p) if p == PointId::NONE => Err(unknown("was removed".into())),
+            Some(&p) => Ok(p),
+        }
+    }
+
+    /// When other inputs still share point `p` with the removed input `i`: `i` leaves
+    /// without the point, whose first occurrence becomes the least of them. True then.
+    fn detach_duplicate(&mut self, i: InputId, p: PointId) -> bool {
+        if self.duplicates == 0 {
+            return false;
+        }
+        let Some(next) = self.input_point.iter().position(|&x| x == p) else {
+            return false;
+        };
+        self.duplicates -= 1;
+        if self.point_input[p.index()] == i {
+            self.point_input[p.index()] = InputId::new(next);
+        }
+        true
+    }
+
+    /// How many removals had to triangulate the remaining points again (their quotient
+    /// would not have been a simplicial complex, or the triangulation was in a covering).
+    pub fn removal_rebuilds(&self) -> usize {
+        self.rebuilds
+    }
+
     /// The orbit space.
     pub fn space(&self) -> &S {
         self.engine.space()
@@ -476,11 +589,18 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         self.point_input[v.index()]
     }
 
-    /// For every input point, the input id of its first occurrence (itself unless duplicate).
+    /// For every input point, the input id of its first occurrence (itself unless
+    /// duplicate; [`InputId::NONE`] once removed).
     pub fn first_occurrences(&self) -> Vec<InputId> {
         self.input_point
             .iter()
-            .map(|&v| self.point_input[v.index()])
+            .map(|&v| {
+                if v == PointId::NONE {
+                    InputId::NONE
+                } else {
+                    self.point_input[v.index()]
+                }
+            })
             .collect()
     }
 

@@ -76,3 +76,34 @@ fn crystals_match_cgal_in_the_covering_and_in_input_order() {
         );
     }
 }
+
+/// Removal against CGAL: the even input points of `rand3_n1000_s1` removed (0, 2, 4, … in
+/// that order, as the anchor's `p3dt3rm` does) leave CGAL's triangulation of the odd ones
+/// (`rand3_n1000_s1_odd`, dumped by the anchor: its point `k` is our input `2k + 1`).
+#[test]
+fn removal_matches_cgal_on_the_survivors() {
+    let (per, pts) = read_oracle_input("rand3_n1000_s1");
+    let ((sheets, v, c), expected) = read_dump("rand3_n1000_s1_odd");
+    let mut tri = PeriodicDelaunay3::build(FlatTorus3::cuboid(per).unwrap(), &pts).unwrap();
+    for i in (0..pts.len()).step_by(2) {
+        tri.remove(orbitri::InputId::new(i)).unwrap();
+    }
+    tri.is_valid().unwrap();
+    assert_eq!(
+        (
+            tri.sheets(),
+            tri.number_of_vertices(),
+            tri.number_of_cells()
+        ),
+        (sheets, v, c)
+    );
+    let mut cells = tri.cells(Copies::Unique);
+    for cell in cells.iter_mut() {
+        cell.vertices = cell.vertices.map(|i| orbitri::InputId((i.0 - 1) / 2));
+    }
+    assert_eq!(
+        canonical_cells(&cells),
+        expected,
+        "cells differ from CGAL's"
+    );
+}

@@ -210,6 +210,42 @@ fn the_triangulations_equal_cgal_p2t2() {
     }
 }
 
+/// Removal against CGAL: the even inputs of `rand2_n1000_s1` removed leave CGAL's
+/// triangulation of the odd ones (`rand2_n1000_s1_odd`: its point `k` is our input `2k + 1`).
+#[test]
+fn removal_equals_cgal_on_the_survivors() {
+    let text = data("rand2_n1000_s1.txt");
+    let mut lines = text.lines().filter(|l| !l.trim().is_empty());
+    let per: Vec<f64> = numbers(lines.next().unwrap());
+    let pts: Vec<[f64; 2]> = lines.map(numbers::<f64>).map(|v| [v[0], v[1]]).collect();
+    let torus = FlatTorus2::cuboid([per[0], per[1]]).unwrap();
+    let mut tri = PeriodicDelaunay2::build(torus, &pts).unwrap();
+    for i in (0..pts.len()).step_by(2) {
+        tri.remove(orbitri::InputId::new(i)).unwrap();
+    }
+    tri.is_valid().unwrap();
+    let dump = data("rand2_n1000_s1_odd.dump2");
+    let mut dl = dump.lines();
+    let header: Vec<usize> = numbers(dl.next().unwrap());
+    let expected: Vec<[i64; 9]> = dl.map(|l| numbers::<i64>(l).try_into().unwrap()).collect();
+    assert_eq!(
+        (
+            tri.sheets(),
+            tri.number_of_vertices(),
+            tri.number_of_cells()
+        ),
+        (header[0], header[1], header[2])
+    );
+    let mut cells = tri.cells(Copies::Stored);
+    for cell in cells.iter_mut() {
+        cell.vertices = cell.vertices.map(|i| orbitri::InputId((i.0 - 1) / 2));
+    }
+    assert!(
+        canonical(&cells) == expected,
+        "triangles differ from CGAL's"
+    );
+}
+
 #[test]
 fn random_sets_on_every_lattice_pass_the_brute_force_check() {
     for (name, lattice) in lattices() {

@@ -18,6 +18,7 @@ use crate::sort::SplitMix;
 use crate::space::{Lifted, OrbitSpace};
 use crate::tds::{Cell, Tds};
 
+pub use remove::Removal;
 pub use validate::Invalid;
 
 /// A lifted point of the space `S` (cells of `N` vertices).
@@ -101,11 +102,10 @@ pub struct Engine<S: OrbitSpace<N>, const N: usize> {
 impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// An empty triangulation of the space.
     pub fn new(space: S) -> Self {
-        let last = space.levels() - 1;
-        Engine {
+        let mut e = Engine {
             hint_shift: space.identity(),
-            copies: space.covering_copies(0),
-            big_limit: space.criterion_radius2(last.min(1)),
+            copies: Vec::new(),
+            big_limit: 0.0,
             space,
             points: Vec::new(),
             vpoint: Vec::new(),
@@ -120,7 +120,29 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             copy_hints: Vec::new(),
             rng: SplitMix::new(0x5eed),
             scratch: Scratch::default(),
-        }
+        };
+        e.clear();
+        e
+    }
+
+    /// Forgets every point: the empty triangulation, whose first insertion starts in the
+    /// covering of level 0 again.
+    pub(crate) fn clear(&mut self) {
+        let last = self.space.levels() - 1;
+        self.points.clear();
+        self.vpoint.clear();
+        self.vcell.clear();
+        self.tds.clear();
+        self.level = 0;
+        self.one_sheeted = false;
+        self.guaranteed = false;
+        self.big.clear();
+        self.big_count = 0;
+        self.big_limit = self.space.criterion_radius2(last.min(1));
+        self.copies = self.space.covering_copies(0);
+        self.hint = CellId(0);
+        self.hint_shift = self.space.identity();
+        self.copy_hints.clear();
     }
 
     /// Reserves room for about `cells` cells and `points` points (bulk construction).

@@ -1,10 +1,25 @@
-//! Vertex removal in the 1-sheeted triangulation: the star of the vertex is replaced by the
-//! Delaunay triangulation of its link, found by gift wrapping over the star's vertices.
+//! Removing and moving points. In the 1-sheeted triangulation the star of the vertex is
+//! replaced by the Delaunay triangulation of its link, found by gift wrapping over the
+//! star's vertices (thesis §3.3.6); when the quotient would stop being a simplicial complex,
+//! or in a covering space, the remaining points are triangulated again from the covering of
+//! level 0 (§3.3.7), which descends the ladder as far as their criterion allows. A move
+//! that keeps the star positively oriented and locally Delaunay only changes coordinates.
 
 use super::wrap::{Owner, Wrapped};
 use super::{Candidate, Engine, LiftedCell};
-use crate::ids::{CellId, VertexId};
+use crate::ids::{CellId, PointId, VertexId};
+use crate::predicates::Sign;
 use crate::space::OrbitSpace;
+
+/// How a point left the triangulation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Removal {
+    /// Its star was triangulated again in place (or it was the last point).
+    InPlace,
+    /// The quotient would not have stayed a simplicial complex, or the triangulation was
+    /// in a covering: the remaining points were triangulated again from the covering.
+    Rebuilt,
+}
 
 /// Why a removal was refused.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -15,6 +30,78 @@ pub enum RemoveError {
 }
 
 impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
+    /// Removes point `p`. The last point then takes its id (`p`'s storage is reused), so
+    /// point ids stay `0..n`; the result is the Delaunay triangulation of the remaining
+    /// points, the same whatever the history (the perturbation makes it unique).
+    pub fn remove_point(&mut self, p: PointId) -> Removal {
+        if self.points.len() == 1 {
+            self.clear();
+            return Removal::InPlace;
+        }
+        if self.one_sheeted && self.remove_vertex(self.vertex_of_point(p)).is_ok() {
+            self.renumber_last_point(p);
+            self.hint = CellId::NONE;
+            return Removal::InPlace;
+        }
+        self.points.swap_remove(p.index());
+        self.rebuild_in_covering();
+        Removal::Rebuilt
+    }
+
+    /// After the vertex of point `p` was removed from the 1-sheeted triangulation: the last
+    /// point moves into its slot, its vertex renamed in the cells around it.
+    fn renumber_last_point(&mut self, p: PointId) {
+        let last = self.points.len() - 1;
+        if p.index() != last {
+            let (from, to) = (VertexId(last as u32), VertexId(p.0));
+            for (c, k, _) in self.star(from) {
+                self.tds.cells[c.index()].v[k] = to;
+            }
+            self.vcell[p.index()] = self.vcell[last];
+            self.points[p.index()] = self.points[last];
+        }
+        self.points.pop();
+        self.vpoint.pop();
+        self.vcell.pop();
+    }
+
+    /// Moves point `p` to `to` (a canonical point of the domain) by changing its
+    /// coordinates alone, when that leaves a Delaunay triangulation: every cell around it
+    /// positively oriented and every facet of those cells locally Delaunay (CGAL's
+    /// `move_if_no_collision` test), and the criterion of the quotient still holding. The
+    /// star then stays a star-shaped triangulation around `to`, so `to` meets no other
+    /// point. Returns false, with nothing changed, otherwise (then remove and insert).
+    pub fn try_move(&mut self, p: PointId, to: S::Point) -> bool {
+        if !(self.one_sheeted && self.guaranteed) {
+            return false;
+        }
+        let v = self.vertex_of_point(p);
+        let star = self.star(v);
+        let old = std::mem::replace(&mut self.points[p.index()], to);
+        let limit = self.space.criterion_radius2(self.last_level());
+        let cells: Vec<LiftedCell<S, N>> = star.iter().map(|s| self.lifted_cell(s.0)).collect();
+        let shaped = cells.iter().all(|cell| {
+            self.space.orient(cell) == Sign::Positive && self.space.circumradius2(cell) < limit
+        });
+        let delaunay = shaped
+            && star.iter().zip(&cells).all(|(&(c, _, _), cell)| {
+                (0..N).all(|k| {
+                    let d = self.tds.cells[c.index()].n[k];
+                    let dc = self.tds.cells[d.index()];
+                    let j = dc.mirror(c).expect("symmetric neighbours");
+                    let opposite = (
+                        self.points[self.point_of(dc.v[j]).index()],
+                        self.space.compose(self.translation(c, k, d), dc.off[j]),
+                    );
+                    self.space.in_sphere(cell, opposite) == Sign::Negative
+                })
+            });
+        if !delaunay {
+            self.points[p.index()] = old;
+        }
+        delaunay
+    }
+
     /// Removes vertex `v` of a 1-sheeted triangulation. When the new cells break the switch
     /// criterion, or it already does not hold, the removal goes ahead only if the quotient
     /// stays a simplicial complex (Theorem 2.2.8); otherwise nothing changes.

@@ -1,0 +1,360 @@
+//! Removing and moving points (issue "Dynamic triangulations"): every result against a
+//! fresh build of the surviving points, cell for cell, on the lattices users have (cube,
+//! cuboid, triclinic; square, hexagonal, oblique) and two manifolds; removal down to no
+//! point and back; duplicates; bad ids; random sequences of insertions, removals and moves.
+
+use std::collections::BTreeSet;
+
+use orbitri::sort::SplitMix;
+use orbitri::{Copies, Error, FlatManifold, FlatSpace, FlatTorus, InputId, Removal, Triangulation};
+use proptest::prelude::*;
+
+/// The cells as sets of (point coordinates, element), canonical modulo the group: equal
+/// for two triangulations of one point set in the same space, whatever the ids.
+fn geometry<const D: usize, const N: usize, S: FlatSpace<D, N>>(
+    tri: &Triangulation<D, N, S>,
+) -> BTreeSet<Vec<(Vec<u64>, S::Elem)>> {
+    let pts = tri.points();
+    let mut order: Vec<u32> = (0..pts.len() as u32).collect();
+    order.sort_by(|&x, &y| pts[x as usize].partial_cmp(&pts[y as usize]).unwrap());
+    let mut rank = vec![0; pts.len()];
+    for (r, &v) in order.iter().enumerate() {
+        rank[v as usize] = r as u32;
+    }
+    tri.cells(Copies::Unique)
+        .iter()
+        .map(|c| {
+            let mut pairs: Vec<(u32, S::Elem)> = (0..N)
+                .map(|k| {
+                    (
+                        rank[tri.vertex_of_input(c.vertices[k]).index()],
+                        c.offsets[k],
+                    )
+                })
+                .collect();
+            tri.space().canonical_face(&mut pairs);
+            pairs
+                .iter()
+                .map(|&(r, g)| {
+                    (
+                        pts[order[r as usize] as usize].map(f64::to_bits).to_vec(),
+                        g,
+                    )
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// The live input ids' points, in input order.
+fn survivors<const D: usize, const N: usize, S: FlatSpace<D, N>>(
+    tri: &Triangulation<D, N, S>,
+) -> Vec<[f64; D]> {
+    let first = tri.first_occurrences();
+    (0..tri.number_of_input_points())
+        .filter(|&i| first[i] != InputId::NONE)
+        .map(|i| tri.point(tri.vertex_of_input(InputId::new(i))))
+        .collect()
+}
+
+/// The triangulation equals a fresh build of its surviving points when both live in the
+/// same space (a removal that stayed 1-sheeted while the fresh build of few points starts
+/// in a covering is a valid triangulation of another space: only the quotient's is
+/// compared).
+fn same_as_fresh<const D: usize, const N: usize, S: FlatSpace<D, N>>(
+    tri: &Triangulation<D, N, S>,
+    what: &str,
+) -> bool {
+    tri.is_valid().unwrap_or_else(|e| panic!("{what}: {e}"));
+    let pts = survivors(tri);
+    if pts.is_empty() {
+        assert_eq!(tri.number_of_vertices(), 0, "{what}");
+        return false;
+    }
+    let fresh = Triangulation::<D, N, S>::build(tri.space().clone(), &pts).unwrap();
+    if fresh.sheets() != tri.sheets() {
+        return false;
+    }
+    assert!(
+        geometry(tri) == geometry(&fresh),
+        "{what}: the cells differ from a fresh build of the survivors"
+    );
+    true
+}
+
+fn random<const D: usize>(n: usize, seed: u64, scale: [f64; D]) -> Vec<[f64; D]> {
+    let mut r = SplitMix::new(seed);
+    (0..n)
+        .map(|_| std::array::from_fn(|i| r.unit() * scale[i]))
+        .collect()
+}
+
+fn tori3() -> Vec<(&'static str, FlatTorus<3>)> {
+    vec![
+        ("cube", FlatTorus::cuboid([1.0; 3]).unwrap()),
+        ("cuboid", FlatTorus::cuboid([1.0, 0.75, 1.5]).unwrap()),
+        (
+            "triclinic",
+            FlatTorus::triclinic([[1.0, 0.0, 0.0], [0.3, 0.9, 0.0], [-0.2, 0.25, 1.1]]).unwrap(),
+        ),
+    ]
+}
+
+fn tori2() -> Vec<(&'static str, FlatTorus<2>)> {
+    vec![
+        ("square", FlatTorus::cuboid([1.0; 2]).unwrap()),
+        (
+            "hexagonal",
+            FlatTorus::triclinic([[1.0, 0.0], [0.5, 3f64.sqrt() / 2.0]]).unwrap(),
+        ),
+        (
+            "oblique",
+            FlatTorus::triclinic([[1.0, 0.0], [0.35, 0.8]]).unwrap(),
+        ),
+    ]
+}
+
+/// Removing every other point of a large set stays in the quotient, in place, and gives
+/// the fresh build of the other half.
+#[test]
+fn removals_equal_a_fresh_build_of_the_survivors() {
+    for (name, torus) in tori3() {
+        let mut tri = Triangulation::<3, 4, _>::build(torus, &random(3000, 1, [1.0; 3])).unwrap();
+        for i in (0..3000).step_by(2) {
+            assert_eq!(
+                tri.remove(InputId::new(i)).unwrap(),
+                Removal::InPlace,
+                "{name}"
+            );
+        }
+        assert_eq!(tri.number_of_vertices(), 1500);
+        assert!(same_as_fresh(&tri, name), "{name}: one-sheeted both");
+    }
+    for (name, torus) in tori2() {
+        let mut tri = Triangulation::<2, 3, _>::build(torus, &random(2000, 2, [1.0; 2])).unwrap();
+        let mut r = SplitMix::new(3);
+        let mut ids: Vec<usize> = (0..2000).collect();
+        for k in (1..ids.len()).rev() {
+            ids.swap(k, (r.next_u64() % (k as u64 + 1)) as usize);
+        }
+        for &i in &ids[..1000] {
+            tri.remove(InputId::new(i)).unwrap();
+        }
+        assert!(same_as_fresh(&tri, name), "{name}");
+    }
+}
+
+/// Down to no point, the way back up the covering on the way (a few points cannot keep a
+/// simplicial quotient), then inserting again.
+#[test]
+fn removal_down_to_nothing_and_back() {
+    for (name, torus) in tori3().into_iter().take(2) {
+        let pts = random(60, 4, [1.0; 3]);
+        let mut tri = Triangulation::<3, 4, _>::build(torus, &pts).unwrap();
+        let mut sheets = BTreeSet::new();
+        for i in (0..60).rev() {
+            tri.remove(InputId::new(i)).unwrap();
+            sheets.insert(tri.sheets());
+            if i % 7 == 0 {
+                same_as_fresh(&tri, name);
+            } else {
+                tri.is_valid().unwrap_or_else(|e| panic!("{name}: {e}"));
+            }
+        }
+        assert_eq!((tri.number_of_vertices(), tri.number_of_cells()), (0, 0));
+        assert!(
+            sheets.len() > 1,
+            "{name}: went back to the covering ({sheets:?})"
+        );
+        assert!(tri.removal_rebuilds() > 0);
+        for p in &pts[..20] {
+            tri.insert(*p).unwrap();
+        }
+        assert!(same_as_fresh(&tri, name) || tri.sheets() > 1);
+        tri.is_valid().unwrap();
+    }
+    for (name, torus) in tori2() {
+        let mut tri = Triangulation::<2, 3, _>::build(torus, &random(40, 5, [1.0; 2])).unwrap();
+        let mut levels = BTreeSet::new();
+        for i in 0..40 {
+            tri.remove(InputId::new(i)).unwrap();
+            levels.insert(tri.sheets());
+            tri.is_valid().unwrap_or_else(|e| panic!("{name}: {e}"));
+        }
+        // the 2D ladder: the way back stops at the level the remaining points allow
+        assert!(levels.len() >= 3, "{name}: {levels:?}");
+    }
+}
+
+#[test]
+fn manifolds_remove_and_move_too() {
+    let klein = FlatManifold::klein_bottle(1.0, 0.75).unwrap();
+    let mut k = Triangulation::<2, 3, _>::build(klein, &random(1500, 6, [1.0, 0.75])).unwrap();
+    let hw = FlatManifold::platycosm("didicosm", [1.0, 1.0, 1.25]).unwrap();
+    let mut m = Triangulation::<3, 4, _>::build(hw, &random(1500, 7, [1.0, 1.0, 1.25])).unwrap();
+    for i in (0..1500).step_by(3) {
+        k.remove(InputId::new(i)).unwrap();
+        m.remove(InputId::new(i)).unwrap();
+    }
+    let mut r = SplitMix::new(8);
+    for i in (1..1500).step_by(3) {
+        let mut jiggle = |x: f64| x + (r.unit() - 0.5) * 1e-3;
+        let p = k.point(k.vertex_of_input(InputId::new(i)));
+        k.move_point(InputId::new(i), p.map(&mut jiggle)).unwrap();
+        let q = m.point(m.vertex_of_input(InputId::new(i)));
+        m.move_point(InputId::new(i), q.map(&mut jiggle)).unwrap();
+    }
+    assert!(same_as_fresh(&k, "klein"));
+    assert!(same_as_fresh(&m, "didicosm"));
+}
+
+/// Small moves mostly keep the combinatorics and only change coordinates; large ones
+/// remove and insert; a move onto another point makes a duplicate.
+#[test]
+fn moves_keep_ids_and_equal_a_fresh_build() {
+    let torus = FlatTorus::cuboid([1.0; 3]).unwrap();
+    let n = 2000;
+    let mut tri = Triangulation::<3, 4, _>::build(torus, &random(n, 9, [1.0; 3])).unwrap();
+    let spacing = (1.0 / n as f64).cbrt();
+    let mut r = SplitMix::new(10);
+    let mut fast = 0;
+    for i in 0..n {
+        let id = InputId::new(i);
+        let p = tri.point(tri.vertex_of_input(id));
+        let to = p.map(|x| x + (r.unit() - 0.5) * 0.02 * spacing);
+        fast += tri.move_point(id, to).unwrap() as usize;
+    }
+    assert!(fast > n / 2, "{fast} of {n} moves changed coordinates only");
+    assert!(same_as_fresh(&tri, "small moves"));
+    // large moves: anywhere in the box, across its boundary too
+    for i in (0..n).step_by(5) {
+        let to = [r.unit() * 3.0 - 1.0, r.unit(), r.unit() - 1.0];
+        tri.move_point(InputId::new(i), to).unwrap();
+    }
+    assert!(same_as_fresh(&tri, "large moves"));
+    // onto another point: a duplicate, the ids kept
+    let target = tri.point(tri.vertex_of_input(InputId(1)));
+    tri.move_point(InputId(3), target).unwrap();
+    assert_eq!(
+        tri.vertex_of_input(InputId(3)),
+        tri.vertex_of_input(InputId(1))
+    );
+    assert_eq!(tri.duplicates(), 1);
+    assert_eq!(tri.number_of_vertices(), n - 1);
+    // and away again
+    tri.move_point(InputId(3), [0.123, 0.456, 0.789]).unwrap();
+    assert_eq!((tri.duplicates(), tri.number_of_vertices()), (0, n));
+    assert!(same_as_fresh(&tri, "duplicates"));
+}
+
+#[test]
+fn duplicates_keep_their_point_until_the_last_goes() {
+    let torus = FlatTorus::cuboid([1.0; 2]).unwrap();
+    let mut pts = random(300, 11, [1.0; 2]);
+    pts[5] = [0.375, 0.6875];
+    pts.push(pts[5]); // input 300 duplicates input 5
+    pts.push([1.375, -0.3125]); // 301: an exact image of it
+    let mut tri = Triangulation::<2, 3, _>::build(torus, &pts).unwrap();
+    assert_eq!(tri.duplicates(), 2);
+    let p = tri.vertex_of_input(InputId(5));
+    let at = tri.point(p);
+    tri.remove(InputId(5)).unwrap();
+    assert_eq!(tri.number_of_vertices(), 300);
+    assert_eq!(tri.first_occurrences()[300], InputId(300));
+    assert_eq!(tri.first_occurrences()[301], InputId(300));
+    assert_eq!(tri.first_occurrences()[5], InputId::NONE);
+    assert_eq!(tri.point(tri.vertex_of_input(InputId(301))), at);
+    tri.remove(InputId(300)).unwrap();
+    assert_eq!(tri.number_of_vertices(), 300);
+    tri.remove(InputId(301)).unwrap();
+    assert_eq!((tri.number_of_vertices(), tri.duplicates()), (299, 0));
+    assert!(same_as_fresh(&tri, "duplicates"));
+}
+
+#[test]
+fn bad_ids_and_coordinates_change_nothing() {
+    let torus = FlatTorus::cuboid([1.0; 3]).unwrap();
+    let mut tri = Triangulation::<3, 4, _>::build(torus, &random(500, 12, [1.0; 3])).unwrap();
+    tri.remove(InputId(17)).unwrap();
+    let before = geometry(&tri);
+    let e = tri.remove(InputId(17)).unwrap_err();
+    assert!(matches!(e, Error::UnknownInput { id: 17, .. }));
+    assert_eq!(e.to_string(), "input id 17: was removed");
+    let e = tri.remove(InputId(500)).unwrap_err().to_string();
+    assert_eq!(
+        e,
+        "input id 500: out of range (500 input points were given)"
+    );
+    assert!(tri.remove(InputId::NONE).is_err());
+    assert!(tri.move_point(InputId(17), [0.5; 3]).is_err());
+    let e = tri
+        .move_point(InputId(3), [0.5, f64::NAN, 0.5])
+        .unwrap_err();
+    assert!(
+        matches!(e, Error::NonFiniteCoordinate { index: 3, axis: 1, value } if value.is_nan()),
+        "{e}"
+    );
+    assert!(tri
+        .move_point(InputId(3), [0.5, 0.5, f64::INFINITY])
+        .is_err());
+    assert!(geometry(&tri) == before);
+    tri.is_valid().unwrap();
+}
+
+/// One step of a random sequence.
+#[derive(Clone, Debug)]
+enum Op {
+    Insert([f64; 2]),
+    Remove(usize),
+    Move(usize, [f64; 2]),
+}
+
+fn op() -> impl Strategy<Value = Op> {
+    // coordinates on a coarse grid: cospherical sets and duplicates are common
+    let coord = (0u32..16).prop_map(|k| k as f64 / 16.0);
+    let point = [coord.clone(), coord];
+    prop_oneof![
+        3 => point.clone().prop_map(Op::Insert),
+        2 => any::<usize>().prop_map(Op::Remove),
+        2 => (any::<usize>(), point).prop_map(|(i, p)| Op::Move(i, p)),
+    ]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+
+    /// Random insertions, removals and moves on grid points (crystals and duplicates) in
+    /// the three 2D lattices: valid after every step, and the fresh build's cells at the end.
+    #[test]
+    fn random_sequences_stay_delaunay(ops in proptest::collection::vec(op(), 1..80), lattice in 0usize..3) {
+        let (name, torus) = tori2().swap_remove(lattice);
+        let mut tri = Triangulation::<2, 3, _>::new(torus);
+        for (step, op) in ops.iter().enumerate() {
+            let live: Vec<usize> = tri
+                .first_occurrences()
+                .iter()
+                .enumerate()
+                .filter(|(_, f)| **f != InputId::NONE)
+                .map(|(i, _)| i)
+                .collect();
+            match *op {
+                Op::Insert(p) => {
+                    tri.insert(p).unwrap();
+                }
+                Op::Remove(k) if !live.is_empty() => {
+                    tri.remove(InputId::new(live[k % live.len()])).unwrap();
+                }
+                Op::Move(k, p) if !live.is_empty() => {
+                    tri.move_point(InputId::new(live[k % live.len()]), p).unwrap();
+                }
+                _ => {
+                    prop_assert!(tri.remove(InputId(0)).is_err());
+                }
+            }
+            if tri.number_of_vertices() > 0 {
+                prop_assert!(tri.is_valid().is_ok(), "{name}, step {step} {op:?}: {:?}", tri.is_valid());
+            }
+        }
+        same_as_fresh(&tri, name);
+    }
+}
