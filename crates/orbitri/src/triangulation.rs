@@ -317,7 +317,10 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
                 return Ok(false);
             }
         }
-        self.engine.drop_leading_points(k);
+        let dummy: Vec<bool> = (0..self.engine.points().len())
+            .map(|p| p < k as usize)
+            .collect();
+        self.engine.compact(&dummy);
         self.point_input.drain(..k as usize);
         for p in self.input_point.iter_mut() {
             *p = PointId(p.0 - k);
@@ -431,6 +434,50 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             }
         }
         Ok(how)
+    }
+
+    /// Removes the input points `ids`, in that order, all or nothing: an unknown, removed or
+    /// repeated id is an error that changes nothing. The result is that of removing them
+    /// one by one ([`Self::remove`]), but the points left are renumbered once, at the end,
+    /// instead of once per removal. Returns whether the remaining points had to be
+    /// triangulated again (see [`Removal`]).
+    pub fn remove_all(&mut self, ids: &[InputId]) -> Result<Removal> {
+        let mut seen = HashSet::with_capacity(ids.len());
+        for &i in ids {
+            self.live_point(i)?;
+            if !seen.insert(i) {
+                return Err(Error::UnknownInput {
+                    id: i.0 as u64,
+                    why: "is given twice".into(),
+                });
+            }
+        }
+        let mut gone = Vec::with_capacity(ids.len());
+        for &i in ids {
+            let p = self.input_point[i.index()];
+            self.input_point[i.index()] = PointId::NONE;
+            if !self.detach_duplicate(i, p) {
+                gone.push(p);
+            }
+        }
+        if gone.is_empty() {
+            return Ok(Removal::InPlace);
+        }
+        let (map, rebuilt) = self.engine.remove_points(&gone);
+        for p in self.input_point.iter_mut().filter(|p| **p != PointId::NONE) {
+            *p = map[p.index()];
+        }
+        let mut k = 0;
+        self.point_input.retain(|_| {
+            k += 1;
+            map[k - 1] != PointId::NONE
+        });
+        self.rebuilds += rebuilt as usize;
+        Ok(if rebuilt {
+            Removal::Rebuilt
+        } else {
+            Removal::InPlace
+        })
     }
 
     /// Moves input point `i` to `to`, keeping its id. A move that leaves the cells around

@@ -130,6 +130,36 @@ fn removals_equal_a_fresh_build_of_the_survivors() {
         assert_eq!(tri.number_of_vertices(), 1500);
         assert!(same_as_fresh(&tri, name), "{name}: one-sheeted both");
     }
+    // the same removals at once: one renumbering at the end, the same cells
+    for (name, torus) in tori3() {
+        let pts = random(3000, 1, [1.0; 3]);
+        let mut one = Triangulation::<3, 4, _>::build(torus.clone(), &pts).unwrap();
+        let mut all = Triangulation::<3, 4, _>::build(torus, &pts).unwrap();
+        let ids: Vec<InputId> = (0..3000).rev().step_by(3).map(InputId::new).collect();
+        for &i in &ids {
+            one.remove(i).unwrap();
+        }
+        assert_eq!(all.remove_all(&ids).unwrap(), Removal::InPlace);
+        all.is_valid().unwrap();
+        assert!(geometry(&one) == geometry(&all), "{name}");
+        assert_eq!(one.first_occurrences(), all.first_occurrences(), "{name}");
+        assert!(same_as_fresh(&all, name));
+        // all or nothing
+        let before = geometry(&all);
+        assert!(
+            all.remove_all(&[InputId(1), InputId(2)]).is_err(),
+            "2 was removed"
+        );
+        assert!(all.remove_all(&[InputId(1), InputId(1)]).is_err(), "twice");
+        assert!(geometry(&all) == before);
+        // everything
+        let live: Vec<InputId> = (0..3000)
+            .map(InputId::new)
+            .filter(|i| !ids.contains(i))
+            .collect();
+        all.remove_all(&live).unwrap();
+        assert_eq!((all.number_of_vertices(), all.number_of_cells()), (0, 0));
+    }
     for (name, torus) in tori2() {
         let mut tri = Triangulation::<2, 3, _>::build(torus, &random(2000, 2, [1.0; 2])).unwrap();
         let mut r = SplitMix::new(3);
@@ -306,6 +336,7 @@ fn bad_ids_and_coordinates_change_nothing() {
 enum Op {
     Insert([f64; 2]),
     Remove(usize),
+    RemoveAll(usize, usize),
     Move(usize, [f64; 2]),
 }
 
@@ -316,6 +347,7 @@ fn op() -> impl Strategy<Value = Op> {
     prop_oneof![
         3 => point.clone().prop_map(Op::Insert),
         2 => any::<usize>().prop_map(Op::Remove),
+        1 => (any::<usize>(), 1usize..6).prop_map(|(a, k)| Op::RemoveAll(a, k)),
         2 => (any::<usize>(), point).prop_map(|(i, p)| Op::Move(i, p)),
     ]
 }
@@ -343,6 +375,13 @@ proptest! {
                 }
                 Op::Remove(k) if !live.is_empty() => {
                     tri.remove(InputId::new(live[k % live.len()])).unwrap();
+                }
+                Op::RemoveAll(a, k) if !live.is_empty() => {
+                    let mut ids: Vec<InputId> =
+                        (0..k).map(|j| InputId::new(live[(a + 7 * j) % live.len()])).collect();
+                    ids.sort_unstable();
+                    ids.dedup();
+                    tri.remove_all(&ids).unwrap();
                 }
                 Op::Move(k, p) if !live.is_empty() => {
                     tri.move_point(InputId::new(live[k % live.len()]), p).unwrap();

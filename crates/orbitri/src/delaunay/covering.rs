@@ -2,6 +2,7 @@
 //! the next level once its criterion holds (to the quotient also once the 1-skeleton has no
 //! cycle of length ≤ 2, Theorem 2.2.8), and the way back to level 0.
 
+use std::borrow::Cow;
 use std::collections::HashMap;
 
 use rayon::prelude::*;
@@ -93,7 +94,11 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 seeds,
                 |vids, arr, idx| {
                     let k = (idx + 1) % N;
-                    self.wrap_candidates(&around, self.vpoint[vids[k].index()], arr[k].1)
+                    Cow::Owned(self.wrap_candidates(
+                        &around,
+                        self.vpoint[vids[k].index()],
+                        arr[k].1,
+                    ))
                 },
                 vec![first],
                 true,
@@ -208,20 +213,25 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.hint = CellId(0);
     }
 
-    /// Drops the first `k` points (the dummies, once removed) and renumbers the rest.
-    pub(crate) fn drop_leading_points(&mut self, k: u32) {
+    /// Drops the points whose vertices were removed (`gone`, 1-sheeted) and renumbers the
+    /// rest in order, in one pass over the cells. Returns each old point's new id
+    /// ([`PointId::NONE`] for the dropped ones).
+    pub(crate) fn compact(&mut self, gone: &[bool]) -> Vec<PointId> {
         debug_assert!(self.one_sheeted);
-        self.points.drain(..k as usize);
+        let map = renumbering(gone);
+        drop_gone(&mut self.points, gone);
+        drop_gone(&mut self.vcell, gone);
         self.vpoint = (0..self.points.len() as u32).map(PointId).collect();
-        self.vcell.drain(..k as usize);
         for c in 0..self.tds.cells.len() as u32 {
             let c = CellId(c);
             if self.tds.is_alive(c) {
                 for v in self.tds.cells[c.index()].v.iter_mut() {
-                    *v = VertexId(v.0 - k);
+                    *v = VertexId(map[v.index()].0);
                 }
             }
         }
+        self.hint = CellId::NONE;
+        map
     }
 
     /// At the end of a construction still in the covering: switch to the quotient if it is
@@ -240,6 +250,30 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         }
         self.one_sheeted
     }
+}
+
+/// The new ids of the points that stay, in order ([`PointId::NONE`] for the others).
+pub(super) fn renumbering(gone: &[bool]) -> Vec<PointId> {
+    let mut next = 0u32;
+    gone.iter()
+        .map(|&g| {
+            next += !g as u32;
+            if g {
+                PointId::NONE
+            } else {
+                PointId(next - 1)
+            }
+        })
+        .collect()
+}
+
+/// Keeps the entries of `v` that are not `gone`.
+pub(super) fn drop_gone<T>(v: &mut Vec<T>, gone: &[bool]) {
+    let mut k = 0;
+    v.retain(|_| {
+        k += 1;
+        !gone[k - 1]
+    });
 }
 
 /// The canonical form of a covering cell in the space of `level`: offsets translated by that

@@ -5,6 +5,9 @@
 //! level 0 (§3.3.7), which descends the ladder as far as their criterion allows. A move
 //! that keeps the star positively oriented and locally Delaunay only changes coordinates.
 
+use std::borrow::Cow;
+
+use super::covering::{drop_gone, renumbering};
 use super::wrap::{Owner, Wrapped};
 use super::{Candidate, Engine, LiftedCell};
 use crate::ids::{CellId, PointId, VertexId};
@@ -46,6 +49,35 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.points.swap_remove(p.index());
         self.rebuild_in_covering();
         Removal::Rebuilt
+    }
+
+    /// Removes the points `ps` (distinct), in that order: in place while the quotient allows,
+    /// then, if one would break it, from the covering with the rest. The points left are
+    /// renumbered in order once at the end (one pass over the cells, instead of one star per
+    /// removal); returns each old point's new id ([`PointId::NONE`] for the removed) and
+    /// whether the remaining points had to be triangulated again.
+    pub fn remove_points(&mut self, ps: &[PointId]) -> (Vec<PointId>, bool) {
+        let n = self.points.len();
+        let mut gone = vec![false; n];
+        let mut rebuild = !self.one_sheeted;
+        for &p in ps {
+            gone[p.index()] = true;
+            if !rebuild && self.remove_vertex(self.vertex_of_point(p)).is_err() {
+                rebuild = true;
+            }
+        }
+        if ps.len() == n {
+            self.clear();
+            return (vec![PointId::NONE; n], false);
+        }
+        if !rebuild {
+            return (self.compact(&gone), false);
+        }
+        // (removed vertices and the one refused are all dropped with the others)
+        let map = renumbering(&gone);
+        drop_gone(&mut self.points, &gone);
+        self.rebuild_in_covering();
+        (map, true)
     }
 
     /// After the vertex of point `p` was removed from the 1-sheeted triangulation: the last
@@ -137,7 +169,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             seeds.push((v, arr, i, true, Owner::Old(d, j)));
         }
         let cells = self
-            .wrap(seeds, |_, _, _| hole.clone(), Vec::new(), false)
+            .wrap(seeds, |_, _, _| Cow::Borrowed(&hole[..]), Vec::new(), false)
             .ok_or(RemoveError::NotSimplicial)?;
         let limit = self.space.criterion_radius2(self.last_level());
         let breaks = cells

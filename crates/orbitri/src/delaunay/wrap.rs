@@ -3,7 +3,9 @@
 //! perturbed in-sphere test, so one pass finds the apex). It builds the first triangulation
 //! of a space and fills the hole left by a removed vertex.
 
-use std::collections::HashMap;
+use std::borrow::Cow;
+
+use rustc_hash::FxHashMap;
 
 use super::{Candidate, Engine, LiftedCell};
 use crate::ids::{CellId, VertexId};
@@ -91,14 +93,23 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// With `recenter`, each new cell is moved into the canonical form of the current level
     /// (candidates are then searched around it): wrapping a whole covering visits its cells
     /// in a snake that may wander many periods away, and the group elements must stay small.
-    pub(super) fn wrap(
+    pub(super) fn wrap<'c>(
         &self,
         seeds: Vec<Seed<S, N>>,
-        mut candidates: impl FnMut(&[VertexId; N], &LiftedCell<S, N>, usize) -> Vec<Candidate<S, N>>,
+        mut candidates: impl FnMut(
+            &[VertexId; N],
+            &LiftedCell<S, N>,
+            usize,
+        ) -> Cow<'c, [Candidate<S, N>]>,
         mut first: Vec<Wrapped<S::Point, S::Elem, N>>,
         recenter: bool,
-    ) -> Option<Vec<Wrapped<S::Point, S::Elem, N>>> {
-        let mut open: HashMap<[VertexId; N], Open<S::Point, S::Elem, N>> = HashMap::new();
+    ) -> Option<Vec<Wrapped<S::Point, S::Elem, N>>>
+    where
+        S::Point: 'c,
+        S::Elem: 'c,
+    {
+        // a fast non-cryptographic hash: the keys are small vertex ids of our own
+        let mut open: FxHashMap<[VertexId; N], Open<S::Point, S::Elem, N>> = FxHashMap::default();
         let mut queue: Vec<[VertexId; N]> = Vec::new();
         for (vids, arr, idx, toward, owner) in seeds {
             let key = facet_key(&vids, idx);
