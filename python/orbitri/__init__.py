@@ -247,6 +247,42 @@ class _Delaunay:
         """
         return self._tri.insert(_points(points, self.dimension))
 
+    def remove(self, ids) -> int:
+        """Removes input points (one id or a sequence of ids), all or none. The other ids
+        never change; afterwards the triangulation is the one a fresh build of the remaining
+        points gives. A removed id's row of ``points`` is NaN and its ``duplicates`` entry
+        -1. An id never given, removed, or repeated is an ``IndexError``; returns 1 when the
+        remaining points had to be triangulated again from the covering space, else 0.
+
+        >>> import orbitri
+        >>> tri = orbitri.PeriodicDelaunay([[0.1, 0.2], [0.6, 0.7], [0.3, 0.8]], [1.0, 1.0])
+        >>> tri.remove([0, 2])
+        1
+        >>> tri.duplicates.tolist()
+        [-1, 1, -1]
+        >>> tri.remove(0)
+        Traceback (most recent call last):
+        ...
+        IndexError: input id 0: was removed
+        """
+        return self._tri.remove(ids)
+
+    def move(self, ids, points) -> np.ndarray:
+        """Moves input points ``ids`` to ``points`` (one row each), keeping their ids, all
+        or none (ids and coordinates are checked first). Returns per point whether the move
+        only changed its coordinates (the cells around it stayed Delaunay; otherwise it was
+        removed and inserted again). A move onto another point makes a duplicate.
+
+        >>> import orbitri
+        >>> tri = orbitri.PeriodicDelaunay([[0.1, 0.2], [0.6, 0.7], [0.3, 0.8]], [1.0, 1.0])
+        >>> tri.move([1], [[0.61, 0.7]]).shape
+        (1,)
+        >>> tri.points[1].tolist()
+        [0.61, 0.7]
+        """
+        ids = np.atleast_1d(np.asarray(ids))
+        return self._tri.move(ids.tolist(), _points(points, self.dimension))
+
     def locate(self, point):
         """The simplex containing ``point``: (vertex ids, their elements, the point's
         element in that simplex's frame)."""

@@ -281,6 +281,57 @@ fn insert_all<const D: usize, const N: usize, S: Served<D, N>>(
         .collect())
 }
 
+/// Moves every input of `ids` to its row of `flat`, after checking that the ids are live
+/// and distinct (nothing moves otherwise).
+fn move_all<const D: usize, const N: usize, S: Served<D, N>>(
+    t: &mut Tri_<D, N, S>,
+    ids: &[InputId],
+    flat: &[f64],
+) -> orbitri::Result<Vec<bool>> {
+    let mut seen = std::collections::HashSet::new();
+    for &i in ids {
+        if !t.contains(i) || !seen.insert(i) {
+            // the same error `remove` gives for that id
+            return Err(t
+                .remove_all(&[i, i])
+                .expect_err("an unknown or repeated id"));
+        }
+    }
+    ids.iter()
+        .zip(flat.chunks_exact(D))
+        .map(|(&i, q)| t.move_point(i, std::array::from_fn(|c| q[c])))
+        .collect()
+}
+
+/// Input ids from Python: one integer or a sequence of them (Python's or numpy's; a float
+/// is a TypeError, a negative or huge one an IndexError).
+fn input_ids(py: Python<'_>, ids: &Bound<'_, PyAny>) -> PyResult<Vec<InputId>> {
+    let raw: Vec<i64> = match ids.extract::<i64>() {
+        Ok(i) => vec![i],
+        Err(e) if e.is_instance_of::<PyOverflowError>(py) => {
+            return Err(PyIndexError::new_err(format!("point {ids} does not exist")))
+        }
+        Err(_) => ids.extract::<Vec<i64>>()?,
+    };
+    raw.into_iter()
+        .map(|i| {
+            u32::try_from(i)
+                .ok()
+                .filter(|&i| i != u32::MAX)
+                .map(InputId)
+                .ok_or_else(|| PyIndexError::new_err(format!("point {i} does not exist")))
+        })
+        .collect()
+}
+
+/// An unknown or removed input id is an IndexError, the rest a ValueError.
+fn id_error(e: orbitri::Error) -> PyErr {
+    match e {
+        orbitri::Error::UnknownInput { .. } => PyIndexError::new_err(e.to_string()),
+        e => value_error(e),
+    }
+}
+
 /// Elements as Python sees them, for an array of shape `lead`: a torus's offsets
 /// (`lead × D`), a manifold's `(cosets, offsets)` (`lead` and `lead × D`).
 fn py_elements<const D: usize, const N: usize, S: Served<D, N>>(
@@ -484,8 +535,16 @@ impl Triangulation {
         let d = self.dim;
         Ok(with_tri!(&*self.read(py)?, t => {
             let n = t.number_of_input_points();
+            // a removed input's row is NaN
             let v: Vec<f64> = (0..n)
-                .flat_map(|i| t.point(t.vertex_of_input(InputId::new(i))))
+                .map(InputId::new)
+                .flat_map(|i| {
+                    if t.contains(i) {
+                        t.point(t.vertex_of_input(i)).to_vec()
+                    } else {
+                        vec![f64::NAN; d]
+                    }
+                })
                 .collect();
             array2(py, n, d, v)
         }))
@@ -530,13 +589,19 @@ impl Triangulation {
         Ok(with_tri!(&*self.read(py)?, t => t.number_of_input_points()))
     }
 
-    /// For every input point, the input id of its first occurrence.
+    /// For every input point, the input id of its first occurrence (-1 once removed).
     #[getter]
     fn duplicates<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<i64>>> {
         let first = with_tri!(&*self.read(py)?, t => t.first_occurrences());
         Ok(first
             .into_iter()
-            .map(|f| i64::from(f.0))
+            .map(|f| {
+                if f == InputId::NONE {
+                    -1
+                } else {
+                    i64::from(f.0)
+                }
+            })
             .collect::<Array1<i64>>()
             .into_pyarray(py))
     }
@@ -574,6 +639,59 @@ impl Triangulation {
             .map_err(value_error)?;
         self.generation.fetch_add(1, Ordering::AcqRel);
         Ok(Array1::from(ids).into_pyarray(py))
+    }
+
+    /// Removes input points (one id or a sequence of ids), all or none: an id never given,
+    /// removed, negative or given twice is an IndexError naming it. Returns how many
+    /// removals had to triangulate the remaining points again (0 or 1).
+    fn remove(&self, py: Python<'_>, ids: &Bound<'_, PyAny>) -> PyResult<usize> {
+        let ids = input_ids(py, ids)?;
+        let mut guard = self.write(py)?;
+        let tri = &mut *guard;
+        let how = py
+            .detach(|| with_tri!(tri, t => t.remove_all(&ids)))
+            .map_err(id_error)?;
+        self.generation.fetch_add(1, Ordering::AcqRel);
+        Ok((how == orbitri::Removal::Rebuilt) as usize)
+    }
+
+    /// Moves input points `ids` to `points` (rows), keeping their ids, all or none: ids
+    /// and coordinates are checked first. Returns per point whether the move changed its
+    /// coordinates alone (the cells around it stayed Delaunay).
+    #[pyo3(name = "move")]
+    fn move_points<'py>(
+        &self,
+        py: Python<'py>,
+        ids: &Bound<'_, PyAny>,
+        points: PyArrayLike2<'_, f64, AllowTypeChange>,
+    ) -> PyResult<Bound<'py, PyArray1<bool>>> {
+        let ids = input_ids(py, ids)?;
+        let p = points.as_array();
+        let d = self.dim;
+        if p.shape() != [ids.len(), d] {
+            return Err(PyValueError::new_err(format!(
+                "{} ids need {} points of {d} coordinates, not an array of shape {:?}",
+                ids.len(),
+                ids.len(),
+                p.shape()
+            )));
+        }
+        for (row, q) in p.rows().into_iter().enumerate() {
+            if let Some((axis, v)) = q.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+                return Err(PyValueError::new_err(format!(
+                    "point {}: coordinate {axis} is {v}, not a finite number",
+                    ids[row].0
+                )));
+            }
+        }
+        let flat: Vec<f64> = p.iter().copied().collect();
+        let mut guard = self.write(py)?;
+        let tri = &mut *guard;
+        let fast = py
+            .detach(|| with_tri!(tri, t => move_all(t, &ids, &flat)))
+            .map_err(id_error)?;
+        self.generation.fetch_add(1, Ordering::AcqRel);
+        Ok(Array1::from(fast).into_pyarray(py))
     }
 
     /// (vertices, their elements, the point's element) of the cell containing a point.
@@ -617,6 +735,9 @@ impl Triangulation {
             .ok()
             .filter(|&i| i < n)
             .ok_or_else(out_of_range)?;
+        if !with_tri!(&*guard, t => t.contains(InputId::new(i))) {
+            return Err(PyIndexError::new_err(format!("point {i} was removed")));
+        }
         Ok(with_tri!(&*guard, t => vertex_neighbors(py, t, i)))
     }
 
@@ -659,15 +780,12 @@ enum Cells {
 }
 
 impl<const D: usize, const N: usize, S: Served<D, N>> CellsOf<D, N, S> {
-    /// The cell of every input point (a duplicate's is its first occurrence's).
-    fn per_input(&self) -> Vec<usize> {
+    /// The cell of every input point (a duplicate's is its first occurrence's; none for a
+    /// removed input).
+    fn per_input(&self) -> Vec<Option<usize>> {
         self.first
             .iter()
-            .map(|f| {
-                self.cells
-                    .binary_search_by_key(f, |c| c.point)
-                    .expect("every first occurrence has a cell")
-            })
+            .map(|f| self.cells.binary_search_by_key(f, |c| c.point).ok())
             .collect()
     }
 
@@ -735,14 +853,31 @@ struct PerPoint {
 
 impl PerPoint {
     fn of<const D: usize, const N: usize, S: Served<D, N>>(c: &CellsOf<D, N, S>) -> Self {
+        // a removed input's measures are NaN (and -1 faces)
+        let gone = CellMeasures {
+            point: InputId::NONE,
+            volume: f64::NAN,
+            faces: u32::MAX,
+            surface_area: f64::NAN,
+            centroid: [f64::NAN; D],
+        };
         let m: Vec<CellMeasures<D>> = c
             .per_input()
             .into_iter()
-            .map(|k| CellMeasures::from(&c.cells[k]))
+            .map(|k| k.map_or(gone, |k| CellMeasures::from(&c.cells[k])))
             .collect();
         PerPoint {
             volumes: m.iter().map(|x| x.volume).collect(),
-            counts: m.iter().map(|x| i64::from(x.faces)).collect(),
+            counts: m
+                .iter()
+                .map(|x| {
+                    if x.faces == u32::MAX {
+                        -1
+                    } else {
+                        i64::from(x.faces)
+                    }
+                })
+                .collect(),
             surfaces: m.iter().map(|x| x.surface_area).collect(),
             centroids: m.iter().flat_map(|x| x.centroid).collect(),
             dimension: D,

@@ -506,6 +506,11 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         Ok(false)
     }
 
+    /// True when input id `i` was given and not removed.
+    pub fn contains(&self, i: InputId) -> bool {
+        self.live_point(i).is_ok()
+    }
+
     /// The point of a live input id, or the error naming it.
     fn live_point(&self, i: InputId) -> Result<PointId> {
         let unknown = |why: String| Error::UnknownInput {
