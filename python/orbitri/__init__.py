@@ -283,6 +283,19 @@ class _Delaunay:
         ids = np.atleast_1d(np.asarray(ids))
         return self._tri.move(ids.tolist(), _points(points, self.dimension))
 
+    def find_simplex(self, points) -> np.ndarray:
+        """For every query point (rows), the index into ``simplices`` of the simplex that
+        contains it (scipy's name), located in parallel. Points anywhere are wrapped into
+        the domain first; a non-finite coordinate is a ``ValueError`` naming its row.
+
+        >>> import numpy as np, orbitri
+        >>> tri = orbitri.PeriodicDelaunay(np.random.default_rng(0).random((50, 2)), [1.0, 1.0])
+        >>> k = tri.find_simplex([[0.5, 0.5], [1.5, -0.5]])
+        >>> k.shape, bool(k[0] == k[1])
+        ((2,), True)
+        """
+        return self._tri.find_simplex(_points(points, self.dimension))
+
     def locate(self, point):
         """The simplex containing ``point``: (vertex ids, their elements, the point's
         element in that simplex's frame)."""

@@ -84,3 +84,29 @@ def test_down_to_nothing_and_back_in_a_manifold():
     ids = tri.insert(rng.random((10, 2)) * [1.0, 0.75])
     assert ids.tolist() == list(range(30, 40))
     assert tri.is_valid()
+
+
+@pytest.mark.parametrize("d", [2, 3])
+def test_find_simplex_agrees_with_locate_and_barycentric_coordinates(d):
+    rng = np.random.default_rng(10 + d)
+    tri = orbitri.PeriodicDelaunay(rng.random((500, d)), np.ones(d))
+    tri.remove(np.arange(0, 500, 4))
+    queries = rng.random((300, d)) * 3 - 1
+    rows = tri.find_simplex(queries)
+    simplices, offsets = tri.simplices, tri.offsets
+    pts = tri.points
+    for q, k in zip(queries, rows):
+        vertices, _, _ = tri.locate(q)
+        assert sorted(vertices) == sorted(simplices[k])
+        # the wrapped query has non-negative barycentric coordinates in the lifted simplex
+        lifted = pts[simplices[k]] + offsets[k]
+        w = np.mod(q, 1.0)
+        for shift in np.ndindex(*(3,) * d):
+            x = w + np.array(shift) - 1
+            lam = np.linalg.solve(np.vstack([lifted.T, np.ones(d + 1)]), np.append(x, 1.0))
+            if (lam >= -1e-9).all():
+                break
+        else:
+            raise AssertionError(f"{q} is not in simplex {k}")
+    with pytest.raises(ValueError, match="point 1: coordinate 0 is NaN"):
+        tri.find_simplex([[0.5] * d, [np.nan] + [0.5] * (d - 1)])

@@ -281,6 +281,18 @@ fn insert_all<const D: usize, const N: usize, S: Served<D, N>>(
         .collect())
 }
 
+/// The rows of the simplices containing the points of `flat` (rows of `D`).
+fn find_simplex<const D: usize, const N: usize, S: Served<D, N>>(
+    t: &Tri_<D, N, S>,
+    flat: &[f64],
+) -> orbitri::Result<Vec<usize>> {
+    let q: Vec<[f64; D]> = flat
+        .chunks_exact(D)
+        .map(|q| std::array::from_fn(|c| q[c]))
+        .collect();
+    t.find_simplex(&q)
+}
+
 /// Moves every input of `ids` to its row of `flat`, after checking that the ids are live
 /// and distinct (nothing moves otherwise).
 fn move_all<const D: usize, const N: usize, S: Served<D, N>>(
@@ -692,6 +704,34 @@ impl Triangulation {
             .map_err(id_error)?;
         self.generation.fetch_add(1, Ordering::AcqRel);
         Ok(Array1::from(fast).into_pyarray(py))
+    }
+
+    /// For every query point (rows), the row of `cells()`'s simplices containing it,
+    /// located in parallel without the interpreter.
+    fn find_simplex<'py>(
+        &self,
+        py: Python<'py>,
+        points: PyArrayLike2<'_, f64, AllowTypeChange>,
+    ) -> PyResult<Bound<'py, PyArray1<i64>>> {
+        let p = points.as_array();
+        let d = self.dim;
+        if p.shape()[1] != d {
+            return Err(PyValueError::new_err(format!(
+                "points must have {d} columns, not {}",
+                p.shape()[1]
+            )));
+        }
+        let flat: Vec<f64> = p.iter().copied().collect();
+        let guard = self.read(py)?;
+        let tri = &*guard;
+        let rows = py
+            .detach(|| with_tri!(tri, t => find_simplex(t, &flat)))
+            .map_err(value_error)?;
+        Ok(rows
+            .into_iter()
+            .map(|r| r as i64)
+            .collect::<Array1<i64>>()
+            .into_pyarray(py))
     }
 
     /// (vertices, their elements, the point's element) of the cell containing a point.

@@ -7,6 +7,8 @@
 use std::collections::HashSet;
 use std::ops::ControlFlow;
 
+use rayon::prelude::*;
+
 use crate::delaunay::{Engine, Inserted, Invalid, Removal};
 use crate::error::{Error, Result};
 use crate::ids::{CellId, InputId, PointId, VertexId};
@@ -840,6 +842,24 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         let (w, _) = internal_point(self.space(), 0, &p)?;
         let (c, o) = self.engine.locate(w);
         Ok((self.view(c), o))
+    }
+
+    /// For every query point, the row of the stored cell containing it in
+    /// [`Self::cells`]`(Copies::Stored)` (scipy's `find_simplex`); the queries are located
+    /// in parallel. An error names the first non-finite query by its row.
+    pub fn find_simplex(&self, points: &[[f64; D]]) -> Result<Vec<usize>> {
+        if self.number_of_vertices() == 0 {
+            return Err(Error::EmptyInput);
+        }
+        let (internal, _) = internal_points(self.space(), points)?;
+        let mut row = vec![usize::MAX; self.engine.cell_slots()];
+        for (k, c) in self.engine.cell_ids().enumerate() {
+            row[c.index()] = k;
+        }
+        Ok(internal
+            .par_iter()
+            .map(|&w| row[self.engine.locate(w).0.index()])
+            .collect())
     }
 
     /// Checks combinatorics and geometry exactly.

@@ -397,3 +397,35 @@ proptest! {
         same_as_fresh(&tri, name);
     }
 }
+
+/// `find_simplex` gives, per query, the row of `cells(Stored)` that `locate` finds, also
+/// after removals (freed cell slots) and for queries outside the domain.
+#[test]
+fn find_simplex_rows_are_locate_cells() {
+    let torus = FlatTorus::cuboid([1.0; 3]).unwrap();
+    let mut tri = Triangulation::<3, 4, _>::build(torus, &random(800, 13, [1.0; 3])).unwrap();
+    let ids: Vec<InputId> = (0..800).step_by(3).map(InputId::new).collect();
+    tri.remove_all(&ids).unwrap();
+    let queries: Vec<[f64; 3]> = random(500, 14, [3.0; 3])
+        .into_iter()
+        .map(|q| q.map(|x| x - 1.0))
+        .collect();
+    let rows = tri.find_simplex(&queries).unwrap();
+    let cells = tri.cells(Copies::Stored);
+    for (q, &k) in queries.iter().zip(&rows) {
+        let (cell, _) = tri.locate(*q).unwrap();
+        assert_eq!(cells[k].vertices, cell.vertices);
+        assert_eq!(cells[k].offsets, cell.offsets);
+    }
+    let e = tri
+        .find_simplex(&[[0.5; 3], [0.5, f64::NAN, 0.5]])
+        .unwrap_err();
+    assert!(matches!(
+        e,
+        Error::NonFiniteCoordinate {
+            index: 1,
+            axis: 1,
+            ..
+        }
+    ));
+}

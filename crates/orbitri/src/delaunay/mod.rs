@@ -202,6 +202,11 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.tds.len()
     }
 
+    /// One more than the largest cell id (live or free): the length of a table by cell id.
+    pub fn cell_slots(&self) -> usize {
+        self.tds.cells.len()
+    }
+
     /// Ids of the stored cells.
     pub fn cell_ids(&self) -> impl Iterator<Item = CellId> + '_ {
         self.tds.ids()
