@@ -353,7 +353,11 @@ fn op() -> impl Strategy<Value = Op> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+    // 48 cases in the test suite; PROPTEST_CASES=… for a longer run
+    #![proptest_config(ProptestConfig {
+        cases: std::env::var("PROPTEST_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(48),
+        ..ProptestConfig::default()
+    })]
 
     /// Random insertions, removals and moves on grid points (crystals and duplicates) in
     /// the three 2D lattices: valid after every step, and the fresh build's cells at the end.
