@@ -42,8 +42,8 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             return Removal::InPlace;
         }
         if self.one_sheeted && self.remove_vertex(self.vertex_of_point(p)).is_ok() {
+            // (the walk hint stays on the new cells, where a moved point comes back)
             self.renumber_last_point(p);
-            self.hint = CellId::NONE;
             return Removal::InPlace;
         }
         self.points.swap_remove(p.index());
