@@ -183,7 +183,8 @@ class _Delaunay:
 
     def is_valid(self) -> bool:
         """Checks the triangulation exactly: combinatorics, orientation, the empty-sphere
-        property and the Euler characteristic (without holding the interpreter)."""
+        property and the Euler characteristic (without holding the interpreter). Returns
+        ``True``, or raises ``ValueError`` with the reason."""
         return self._tri.is_valid()
 
     def try_one_sheet(self) -> bool:

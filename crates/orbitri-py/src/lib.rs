@@ -578,11 +578,14 @@ impl Triangulation {
         Ok(with_tri!(&*self.read(py)?, t => t.is_one_sheeted()))
     }
 
-    /// Checks combinatorics and geometry exactly (without the interpreter).
+    /// Checks combinatorics and geometry exactly (without the interpreter): true, or a
+    /// ValueError with the reason.
     fn is_valid(&self, py: Python<'_>) -> PyResult<bool> {
         let guard = self.read(py)?;
         let tri = &*guard;
-        Ok(py.detach(|| with_tri!(tri, t => t.is_valid().is_ok())))
+        py.detach(|| with_tri!(tri, t => t.is_valid()))
+            .map(|()| true)
+            .map_err(|e| PyValueError::new_err(format!("invalid triangulation: {e}")))
     }
 
     /// Moves a triangulation still in a covering space to the 1-sheeted quotient if its

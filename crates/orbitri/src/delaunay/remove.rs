@@ -115,10 +115,15 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         let shaped = cells.iter().all(|cell| {
             self.space.orient(cell) == Sign::Positive && self.space.circumradius2(cell) < limit
         });
+        let ids: Vec<CellId> = star.iter().map(|s| s.0).collect();
         let delaunay = shaped
-            && star.iter().zip(&cells).all(|(&(c, _, _), cell)| {
+            && star.iter().zip(&cells).all(|(&(c, i, _), cell)| {
                 (0..N).all(|k| {
                     let d = self.tds.cells[c.index()].n[k];
+                    // a facet between two star cells is tested from one side
+                    if k != i && d < c && ids.contains(&d) {
+                        return true;
+                    }
                     let dc = self.tds.cells[d.index()];
                     let j = dc.mirror(c).expect("symmetric neighbours");
                     let opposite = (
