@@ -16,15 +16,7 @@ anchor_src=${ANCHOR:-$root/../shared/anchors/cgal}
 out=$root/bench/out
 mkdir -p "$out"
 
-if ! [ -x "$out/cgal/cgal_anchor" ]; then
-    if ! dpkg -s libcgal-dev >/dev/null 2>&1; then
-        apt-get update -qq
-        apt-get install -y -qq libcgal-dev libgmp-dev libmpfr-dev libboost-dev >/dev/null
-    fi
-    mkdir -p "$out/cgal"
-    cp "$anchor_src/cgal_anchor.cpp" "$anchor_src/build.sh" "$out/cgal/"
-    (cd "$out/cgal" && ./build.sh)
-fi
+. "$root/bench/anchor.sh"
 cargo build --release -q -p orbitri-cli --manifest-path "$root/Cargo.toml"
 orb=$root/target/release/orbitri
 cgal=$out/cgal/cgal_anchor

@@ -467,6 +467,21 @@ fn cells_of<const D: usize, const N: usize, S: Served<D, N>>(
     })
 }
 
+impl Triangulation {
+    /// Points of this triangulation's dimension (rows), flat; a ValueError otherwise.
+    fn rows_of(&self, points: &PyArrayLike2<'_, f64, AllowTypeChange>) -> PyResult<Vec<f64>> {
+        let p = points.as_array();
+        let d = self.dim;
+        if p.shape()[1] != d {
+            return Err(PyValueError::new_err(format!(
+                "points must have {d} columns, not {}",
+                p.shape()[1]
+            )));
+        }
+        Ok(p.iter().copied().collect())
+    }
+}
+
 #[pymethods]
 impl Triangulation {
     /// The triangulation of a flat torus given by its lattice (rows).
@@ -638,15 +653,7 @@ impl Triangulation {
         py: Python<'py>,
         points: PyArrayLike2<'_, f64, AllowTypeChange>,
     ) -> PyResult<Bound<'py, PyArray1<i64>>> {
-        let p = points.as_array();
-        let d = self.dim;
-        if p.shape()[1] != d {
-            return Err(PyValueError::new_err(format!(
-                "points must have {d} columns, not {}",
-                p.shape()[1]
-            )));
-        }
-        let flat: Vec<f64> = p.iter().copied().collect();
+        let flat = self.rows_of(&points)?;
         let mut guard = self.write(py)?;
         let tri = &mut *guard;
         let ids = py
@@ -716,15 +723,7 @@ impl Triangulation {
         py: Python<'py>,
         points: PyArrayLike2<'_, f64, AllowTypeChange>,
     ) -> PyResult<Bound<'py, PyArray1<i64>>> {
-        let p = points.as_array();
-        let d = self.dim;
-        if p.shape()[1] != d {
-            return Err(PyValueError::new_err(format!(
-                "points must have {d} columns, not {}",
-                p.shape()[1]
-            )));
-        }
-        let flat: Vec<f64> = p.iter().copied().collect();
+        let flat = self.rows_of(&points)?;
         let guard = self.read(py)?;
         let tri = &*guard;
         let rows = py

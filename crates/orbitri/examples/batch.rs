@@ -5,18 +5,10 @@
 //! usage: cargo run --release -p orbitri --example batch [REPS] [N ...]   (default 3, 10⁵)
 use std::time::Instant;
 
-use orbitri::sort::SplitMix;
 use orbitri::{FlatTorus3, PeriodicDelaunay3};
 
-fn uniform(n: usize, seed: u64) -> Vec<[f64; 3]> {
-    let mut r = SplitMix::new(seed);
-    (0..n).map(|_| [r.unit(), r.unit(), r.unit()]).collect()
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
+mod common;
+use common::{median, uniform};
 
 fn main() {
     let args: Vec<usize> = std::env::args()

@@ -11,10 +11,8 @@ use std::time::Instant;
 use orbitri::sort::SplitMix;
 use orbitri::{FlatManifold, FlatSpace, FlatTorus, Motion, PeriodicDelaunay, Triangulation};
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
+mod common;
+use common::median;
 
 fn run<const D: usize, const N: usize>(m: FlatManifold<D>, n: usize, reps: usize)
 where

@@ -9,42 +9,8 @@ use orbitri::sort::SplitMix;
 use orbitri::{Copies, Error, FlatManifold, FlatSpace, FlatTorus, InputId, Removal, Triangulation};
 use proptest::prelude::*;
 
-/// The cells as sets of (point coordinates, element), canonical modulo the group: equal
-/// for two triangulations of one point set in the same space, whatever the ids.
-fn geometry<const D: usize, const N: usize, S: FlatSpace<D, N>>(
-    tri: &Triangulation<D, N, S>,
-) -> BTreeSet<Vec<(Vec<u64>, S::Elem)>> {
-    let pts = tri.points();
-    let mut order: Vec<u32> = (0..pts.len() as u32).collect();
-    order.sort_by(|&x, &y| pts[x as usize].partial_cmp(&pts[y as usize]).unwrap());
-    let mut rank = vec![0; pts.len()];
-    for (r, &v) in order.iter().enumerate() {
-        rank[v as usize] = r as u32;
-    }
-    tri.cells(Copies::Unique)
-        .iter()
-        .map(|c| {
-            let mut pairs: Vec<(u32, S::Elem)> = (0..N)
-                .map(|k| {
-                    (
-                        rank[tri.vertex_of_input(c.vertices[k]).index()],
-                        c.offsets[k],
-                    )
-                })
-                .collect();
-            tri.space().canonical_face(&mut pairs);
-            pairs
-                .iter()
-                .map(|&(r, g)| {
-                    (
-                        pts[order[r as usize] as usize].map(f64::to_bits).to_vec(),
-                        g,
-                    )
-                })
-                .collect()
-        })
-        .collect()
-}
+mod common;
+use common::geometry;
 
 /// The live input ids' points, in input order.
 fn survivors<const D: usize, const N: usize, S: FlatSpace<D, N>>(

@@ -6,6 +6,7 @@ mod common;
 use std::collections::BTreeSet;
 use std::ops::ControlFlow;
 
+use common::geometry;
 use common::universal::{check, Isometry, Manifold};
 use orbitri::sort::SplitMix;
 use orbitri::{
@@ -342,46 +343,6 @@ fn manifolds_unfold_to_their_torus_triangulation() {
     for name in FlatManifold::PLATYCOSMS {
         unfolds_to_the_torus::<3, 4>(FlatManifold::platycosm(name, BOX).unwrap(), 1500, 8);
     }
-}
-
-/// The cells as sets of (point coordinates, element), canonical modulo the group: equal for
-/// two triangulations of one point set whatever the input order.
-fn geometry<const D: usize, const N: usize>(
-    tri: &Triangulation<D, N, FlatManifold<D>>,
-) -> BTreeSet<Vec<(Vec<u64>, Motion<D>)>>
-where
-    FlatManifold<D>: FlatSpace<D, N, Elem = Motion<D>>,
-{
-    let pts = tri.points();
-    let mut order: Vec<u32> = (0..pts.len() as u32).collect();
-    order.sort_by(|&x, &y| pts[x as usize].partial_cmp(&pts[y as usize]).unwrap());
-    let mut rank = vec![0; pts.len()];
-    for (r, &v) in order.iter().enumerate() {
-        rank[v as usize] = r as u32;
-    }
-    tri.cells(Copies::Unique)
-        .iter()
-        .map(|c| {
-            let mut pairs: Vec<(u32, Motion<D>)> = (0..N)
-                .map(|k| {
-                    (
-                        rank[tri.vertex_of_input(c.vertices[k]).index()],
-                        c.offsets[k],
-                    )
-                })
-                .collect();
-            FlatSpace::<D, N>::canonical_face(tri.space(), &mut pairs);
-            pairs
-                .iter()
-                .map(|&(r, g)| {
-                    (
-                        pts[order[r as usize] as usize].map(f64::to_bits).to_vec(),
-                        g,
-                    )
-                })
-                .collect()
-        })
-        .collect()
 }
 
 /// A cubic crystal (every cell decided by the symbolic perturbation) and random points in

@@ -3,10 +3,10 @@
 
 pub mod universal;
 
-use std::collections::HashMap;
+use std::collections::{BTreeSet, HashMap};
 
 use orbitri::sort::SplitMix;
-use orbitri::{CellView, Copies, InputId, PeriodicDelaunay3};
+use orbitri::{CellView, Copies, FlatSpace, InputId, PeriodicDelaunay3, Triangulation};
 
 pub fn uniform(n: usize, seed: u64, scale: [f64; 3]) -> Vec<[f64; 3]> {
     let mut r = SplitMix::new(seed);
@@ -248,4 +248,41 @@ pub fn crystal(cells: usize, basis: &[[f64; 3]], a: f64) -> Vec<[f64; 3]> {
         }
     }
     out
+}
+
+/// The cells as sets of (point coordinates, element), canonical modulo the group: equal
+/// for two triangulations of one point set in the same space, whatever the ids.
+pub fn geometry<const D: usize, const N: usize, S: FlatSpace<D, N>>(
+    tri: &Triangulation<D, N, S>,
+) -> BTreeSet<Vec<(Vec<u64>, S::Elem)>> {
+    let pts = tri.points();
+    let mut order: Vec<u32> = (0..pts.len() as u32).collect();
+    order.sort_by(|&x, &y| pts[x as usize].partial_cmp(&pts[y as usize]).unwrap());
+    let mut rank = vec![0; pts.len()];
+    for (r, &v) in order.iter().enumerate() {
+        rank[v as usize] = r as u32;
+    }
+    tri.cells(Copies::Unique)
+        .iter()
+        .map(|c| {
+            let mut pairs: Vec<(u32, S::Elem)> = (0..N)
+                .map(|k| {
+                    (
+                        rank[tri.vertex_of_input(c.vertices[k]).index()],
+                        c.offsets[k],
+                    )
+                })
+                .collect();
+            tri.space().canonical_face(&mut pairs);
+            pairs
+                .iter()
+                .map(|&(r, g)| {
+                    (
+                        pts[order[r as usize] as usize].map(f64::to_bits).to_vec(),
+                        g,
+                    )
+                })
+                .collect()
+        })
+        .collect()
 }
