@@ -114,29 +114,16 @@ enum Command {
     },
 }
 
-/// The names `--space` takes: the torus, the Klein bottle and the ten closed flat
-/// 3-manifolds (the library says which of these it triangulates).
-const SPACES: [&str; 12] = [
-    "torus",
-    "klein",
-    "torocosm",
-    "dicosm",
-    "tricosm",
-    "tetracosm",
-    "hexacosm",
-    "didicosm",
-    "first-amphicosm",
-    "second-amphicosm",
-    "first-amphidicosm",
-    "second-amphidicosm",
-];
+/// The names `--space` takes besides the closed flat 3-manifolds'
+/// (`FlatManifold::PLATYCOSMS`).
+const TORUS_AND_KLEIN: [&str; 2] = ["torus", "klein"];
 
 #[derive(Args)]
 struct Domain {
     /// The orbit space: a flat torus (default), the Klein bottle (2D: --box L1 L2, the glide
     /// along the first axis) or a closed flat 3-manifold (--box L1 L2 L3, the sides of its
     /// standard domain)
-    #[arg(long, value_name = "NAME", default_value = "torus", value_parser = PossibleValuesParser::new(SPACES))]
+    #[arg(long, value_name = "NAME", default_value = "torus", value_parser = PossibleValuesParser::new(TORUS_AND_KLEIN.into_iter().chain(FlatManifold::PLATYCOSMS)))]
     space: String,
     #[command(flatten)]
     extent: Extent,

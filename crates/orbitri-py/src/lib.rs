@@ -293,26 +293,17 @@ fn find_simplex<const D: usize, const N: usize, S: Served<D, N>>(
     t.find_simplex(&q)
 }
 
-/// Moves every input of `ids` to its row of `flat`, after checking that the ids are live
-/// and distinct (nothing moves otherwise).
+/// Moves every input of `ids` to its row of `flat`, all or nothing.
 fn move_all<const D: usize, const N: usize, S: Served<D, N>>(
     t: &mut Tri_<D, N, S>,
     ids: &[InputId],
     flat: &[f64],
 ) -> orbitri::Result<Vec<bool>> {
-    let mut seen = std::collections::HashSet::new();
-    for &i in ids {
-        if !t.contains(i) || !seen.insert(i) {
-            // the same error `remove` gives for that id
-            return Err(t
-                .remove_all(&[i, i])
-                .expect_err("an unknown or repeated id"));
-        }
-    }
-    ids.iter()
-        .zip(flat.chunks_exact(D))
-        .map(|(&i, q)| t.move_point(i, std::array::from_fn(|c| q[c])))
-        .collect()
+    let to: Vec<[f64; D]> = flat
+        .chunks_exact(D)
+        .map(|q| std::array::from_fn(|c| q[c]))
+        .collect();
+    t.move_all(ids, &to)
 }
 
 /// Input ids from Python: one integer or a sequence of them (Python's or numpy's; a float
@@ -678,7 +669,7 @@ impl Triangulation {
     }
 
     /// Moves input points `ids` to `points` (rows), keeping their ids, all or none: ids
-    /// and coordinates are checked first. Returns per point whether the move changed its
+    /// and coordinates are checked first (by the library's `move_all`). Returns per point whether the move changed its
     /// coordinates alone (the cells around it stayed Delaunay).
     #[pyo3(name = "move")]
     fn move_points<'py>(
@@ -697,14 +688,6 @@ impl Triangulation {
                 ids.len(),
                 p.shape()
             )));
-        }
-        for (row, q) in p.rows().into_iter().enumerate() {
-            if let Some((axis, v)) = q.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-                return Err(PyValueError::new_err(format!(
-                    "point {}: coordinate {axis} is {v}, not a finite number",
-                    ids[row].0
-                )));
-            }
         }
         let flat: Vec<f64> = p.iter().copied().collect();
         let mut guard = self.write(py)?;

@@ -444,16 +444,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     /// instead of once per removal. Returns whether the remaining points had to be
     /// triangulated again (see [`Removal`]).
     pub fn remove_all(&mut self, ids: &[InputId]) -> Result<Removal> {
-        let mut seen = HashSet::with_capacity(ids.len());
-        for &i in ids {
-            self.live_point(i)?;
-            if !seen.insert(i) {
-                return Err(Error::UnknownInput {
-                    id: i.0 as u64,
-                    why: "is given twice".into(),
-                });
-            }
-        }
+        self.check_distinct_live(ids)?;
         let mut gone = Vec::with_capacity(ids.len());
         for &i in ids {
             let p = self.input_point[i.index()];
@@ -511,6 +502,37 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     /// True when input id `i` was given and not removed.
     pub fn contains(&self, i: InputId) -> bool {
         self.live_point(i).is_ok()
+    }
+
+    /// Moves every input of `ids` to its point of `to` ([`Self::move_point`] one by one),
+    /// all or nothing: an unknown, removed or repeated id, or a non-finite coordinate, is
+    /// an error naming the input id, and nothing moves. Returns per point whether only its
+    /// coordinates changed.
+    pub fn move_all(&mut self, ids: &[InputId], to: &[[f64; D]]) -> Result<Vec<bool>> {
+        self.check_distinct_live(ids)?;
+        for (&i, p) in ids.iter().zip(to) {
+            internal_point(self.space(), i.index(), p)?;
+        }
+        ids.iter()
+            .zip(to)
+            .map(|(&i, &p)| self.move_point(i, p))
+            .collect()
+    }
+
+    /// Ok when every id of `ids` is live and none is repeated, else the error naming the
+    /// first that is not.
+    fn check_distinct_live(&self, ids: &[InputId]) -> Result<()> {
+        let mut seen = HashSet::with_capacity(ids.len());
+        for &i in ids {
+            self.live_point(i)?;
+            if !seen.insert(i) {
+                return Err(Error::UnknownInput {
+                    id: i.0 as u64,
+                    why: "is given twice".into(),
+                });
+            }
+        }
+        Ok(())
     }
 
     /// The point of a live input id, or the error naming it.

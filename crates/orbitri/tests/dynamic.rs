@@ -293,7 +293,29 @@ fn bad_ids_and_coordinates_change_nothing() {
     assert!(tri
         .move_point(InputId(3), [0.5, 0.5, f64::INFINITY])
         .is_err());
+    // a batch of moves is all or nothing: a bad id or coordinate anywhere moves none
+    let e = tri.move_all(&[InputId(3), InputId(17)], &[[0.5; 3], [0.25; 3]]);
+    assert_eq!(e.unwrap_err().to_string(), "input id 17: was removed");
+    let e = tri.move_all(&[InputId(3), InputId(3)], &[[0.5; 3], [0.25; 3]]);
+    assert_eq!(e.unwrap_err().to_string(), "input id 3: is given twice");
+    let e = tri.move_all(
+        &[InputId(3), InputId(4)],
+        &[[0.5; 3], [0.25, f64::NAN, 0.5]],
+    );
+    assert!(matches!(
+        e,
+        Err(Error::NonFiniteCoordinate {
+            index: 4,
+            axis: 1,
+            ..
+        })
+    ));
     assert!(geometry(&tri) == before);
+    let fast = tri
+        .move_all(&[InputId(3), InputId(4)], &[[0.5; 3], [0.25; 3]])
+        .unwrap();
+    assert_eq!(fast.len(), 2);
+    assert_eq!(tri.point(tri.vertex_of_input(InputId(4))), [0.25; 3]);
     tri.is_valid().unwrap();
 }
 
