@@ -4,8 +4,9 @@
 //!   1), remove input points 0, 2, 4, … in that order, time the removals alone (the
 //!   anchor's `dt3rm` and `p3dt3rm` do the same): one `remove` per point, and one
 //!   `remove_all` of them all;
-//! * `move N`: N points, every point moved by 1% of the mean spacing, 10 steps, against
-//!   building from scratch at every step.
+//! * `move N`: N points, every point moved by 1% of the mean spacing, 10 steps: one
+//!   `move_point` per point in input order, and one `move_all` per step (Hilbert order),
+//!   against building from scratch at every step.
 //!
 //! usage: cargo run --release -p orbitri --example dynamic remove|move [REPS] [N ...]
 use std::time::Instant;
@@ -60,12 +61,15 @@ fn main() {
             }
             "move" => {
                 let spacing = (1.0 / n as f64).cbrt();
-                let (mut moving, mut scratch, mut fast) = (Vec::new(), Vec::new(), 0);
+                let ids: Vec<InputId> = (0..n).map(InputId::new).collect();
+                let (mut one, mut all, mut scratch, mut fast) =
+                    (Vec::new(), Vec::new(), Vec::new(), 0);
                 for _ in 0..reps {
                     let mut r = SplitMix::new(2);
                     let mut now = pts.clone();
-                    let mut tri = PeriodicDelaunay3::build(torus.clone(), &now).unwrap();
-                    let (mut tm, mut ts) = (0.0, 0.0);
+                    let mut by_one = PeriodicDelaunay3::build(torus.clone(), &now).unwrap();
+                    let mut by_all = PeriodicDelaunay3::build(torus.clone(), &now).unwrap();
+                    let (mut t1, mut ta, mut ts) = (0.0, 0.0, 0.0);
                     for _ in 0..10 {
                         for p in now.iter_mut() {
                             // a random direction, 1% of the spacing
@@ -77,20 +81,27 @@ fn main() {
                         }
                         let t = Instant::now();
                         for (i, p) in now.iter().enumerate() {
-                            fast += tri.move_point(InputId::new(i), *p).unwrap() as usize;
+                            by_one.move_point(InputId::new(i), *p).unwrap();
                         }
-                        tm += t.elapsed().as_secs_f64();
+                        t1 += t.elapsed().as_secs_f64();
+                        let t = Instant::now();
+                        let moved = by_all.move_all(&ids, &now).unwrap();
+                        ta += t.elapsed().as_secs_f64();
+                        fast += moved.iter().filter(|&&m| m).count();
                         let t = Instant::now();
                         let fresh = PeriodicDelaunay3::build(torus.clone(), &now).unwrap();
                         ts += t.elapsed().as_secs_f64();
-                        assert_eq!(fresh.number_of_cells(), tri.number_of_cells());
+                        assert_eq!(fresh.number_of_cells(), by_one.number_of_cells());
+                        assert_eq!(fresh.number_of_cells(), by_all.number_of_cells());
                     }
-                    moving.push(tm);
+                    one.push(t1);
+                    all.push(ta);
                     scratch.push(ts);
                 }
                 println!(
-                    "move N={n} steps=10 move_s={:.3} rebuild_s={:.3} coordinates_only={:.4}",
-                    median(moving),
+                    "move N={n} steps=10 move_point_s={:.3} move_all_s={:.3} rebuild_s={:.3} coordinates_only={:.4}",
+                    median(one),
+                    median(all),
                     median(scratch),
                     fast as f64 / (10 * n * reps) as f64
                 );

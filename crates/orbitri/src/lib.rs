@@ -36,7 +36,7 @@ pub mod tds;
 pub mod triangulation;
 pub mod voronoi;
 
-pub use delaunay::{Engine, Inserted, Invalid, Removal};
+pub use delaunay::{Engine, Inserted, Invalid, Moved, Removal};
 pub use error::{Error, Result};
 pub use ids::{CellId, InputId, PointId, VertexId};
 pub use space::{

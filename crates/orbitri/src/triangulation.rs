@@ -9,7 +9,7 @@ use std::ops::ControlFlow;
 
 use rayon::prelude::*;
 
-use crate::delaunay::{Engine, Inserted, Invalid, Removal};
+use crate::delaunay::{Engine, Inserted, Invalid, Moved, Removal};
 use crate::error::{Error, Result};
 use crate::ids::{CellId, InputId, PointId, VertexId};
 use crate::space::{FlatManifold, FlatSpace, FlatTorus, OrbitSpace};
@@ -421,10 +421,16 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         if self.detach_duplicate(i, p) {
             return Ok(Removal::InPlace);
         }
-        let last = PointId(self.point_input.len() as u32 - 1);
         let how = self.engine.remove_point(p);
         self.rebuilds += (how == Removal::Rebuilt) as usize;
-        // the engine moved the last point into `p`'s slot
+        self.forget_point(p);
+        Ok(how)
+    }
+
+    /// After the engine dropped point `p` and moved the last point into its slot: the
+    /// inputs of the last point now map to `p`.
+    fn forget_point(&mut self, p: PointId) {
+        let last = PointId(self.point_input.len() as u32 - 1);
         self.point_input.swap_remove(p.index());
         if p != last {
             if self.duplicates == 0 {
@@ -435,7 +441,6 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
                 }
             }
         }
-        Ok(how)
     }
 
     /// Removes the input points `ids`, in that order, all or nothing: an unknown, removed or
@@ -475,28 +480,51 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
 
     /// Moves input point `i` to `to`, keeping its id. A move that leaves the cells around
     /// it positively oriented and Delaunay changes its coordinates alone and returns true;
-    /// otherwise the point is removed and inserted again (false). A move onto another
-    /// point makes `i` its duplicate, as an insertion does. A non-finite coordinate or an
-    /// unknown id is an error that changes nothing.
+    /// otherwise its vertex is removed and inserted again, starting from the cells that
+    /// filled its hole (false). A move onto another point makes `i` its duplicate, as an
+    /// insertion does. A non-finite coordinate or an unknown id is an error that changes
+    /// nothing.
     pub fn move_point(&mut self, i: InputId, to: [f64; D]) -> Result<bool> {
-        let p = self.live_point(i)?;
+        self.live_point(i)?;
         let (w, _) = internal_point(self.space(), i.index(), &to)?;
+        Ok(self.move_internal(i, w))
+    }
+
+    /// Moves live input `i` to the internal point `w`.
+    fn move_internal(&mut self, i: InputId, w: [f64; D]) -> bool {
+        let p = self.input_point[i.index()];
         let shared = self.duplicates > 0
             && self
                 .input_point
                 .iter()
                 .enumerate()
                 .any(|(j, &x)| x == p && j != i.index());
-        if !shared && self.engine.try_move(p, w) {
-            return Ok(true);
+        if !shared {
+            match self.engine.move_point(p, w) {
+                Moved::Coordinates => return true,
+                Moved::Reinserted => return false,
+                Moved::Rebuilt => {
+                    self.rebuilds += 1;
+                    return false;
+                }
+                Moved::Duplicate(q) => {
+                    self.forget_point(p);
+                    self.record_duplicate(i, q);
+                    if self.point_input[q.index()] == i {
+                        self.represent(q, w);
+                    }
+                    return false;
+                }
+                Moved::Refused => {}
+            }
         }
-        self.remove(i)?;
+        self.remove(i).expect("a live input");
         if let Inserted::Duplicate(q) = self.insert_wrapped(i, w) {
             if self.point_input[q.index()] == i {
                 self.represent(q, w);
             }
         }
-        Ok(false)
+        false
     }
 
     /// True when input id `i` was given and not removed.
@@ -504,19 +532,37 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         self.live_point(i).is_ok()
     }
 
-    /// Moves every input of `ids` to its point of `to` ([`Self::move_point`] one by one),
-    /// all or nothing: an unknown, removed or repeated id, or a non-finite coordinate, is
-    /// an error naming the input id, and nothing moves. Returns per point whether only its
-    /// coordinates changed.
+    /// Moves every input of `ids` to its point of `to` ([`Self::move_point`]), all or
+    /// nothing: an unknown, removed or repeated id, a non-finite coordinate, or `to` of
+    /// another length than `ids`, is an error naming the input id, and nothing moves. The
+    /// points move in Hilbert order of their targets, so that consecutive moves touch
+    /// neighbouring cells; the result does not depend on the order. Returns per point
+    /// whether only its coordinates changed.
     pub fn move_all(&mut self, ids: &[InputId], to: &[[f64; D]]) -> Result<Vec<bool>> {
-        self.check_distinct_live(ids)?;
-        for (&i, p) in ids.iter().zip(to) {
-            internal_point(self.space(), i.index(), p)?;
+        if ids.len() != to.len() {
+            return Err(Error::InvalidOption {
+                option: "number of target points",
+                value: to.len().to_string(),
+                limit: format!("must equal the number of ids, {}", ids.len()),
+            });
         }
-        ids.iter()
+        self.check_distinct_live(ids)?;
+        let targets = ids
+            .iter()
             .zip(to)
-            .map(|(&i, &p)| self.move_point(i, p))
-            .collect()
+            .map(|(&i, p)| Ok(internal_point(self.space(), i.index(), p)?.0))
+            .collect::<Result<Vec<_>>>()?;
+        let keys: Vec<u64> = targets
+            .iter()
+            .map(|p| self.space().spatial_key(p))
+            .collect();
+        let mut order: Vec<usize> = (0..ids.len()).collect();
+        order.sort_unstable_by_key(|&k| keys[k]);
+        let mut fast = vec![false; ids.len()];
+        for k in order {
+            fast[k] = self.move_internal(ids[k], targets[k]);
+        }
+        Ok(fast)
     }
 
     /// Ok when every id of `ids` is live and none is repeated, else the error naming the
@@ -867,8 +913,10 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     }
 
     /// For every query point, the row of the stored cell containing it in
-    /// [`Self::cells`]`(Copies::Stored)` (scipy's `find_simplex`); the queries are located
-    /// in parallel. An error names the first non-finite query by its row.
+    /// [`Self::cells`]`(Copies::Stored)` (scipy's `find_simplex`). The queries are taken in
+    /// Hilbert order, in parallel chunks, each query walking from the previous one's cell,
+    /// and each chunk's first from the jump-and-walk grid: the cost per query does not
+    /// grow with the triangulation. An error names the first non-finite query by its row.
     pub fn find_simplex(&self, points: &[[f64; D]]) -> Result<Vec<usize>> {
         if self.number_of_vertices() == 0 {
             return Err(Error::EmptyInput);
@@ -878,10 +926,33 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         for (k, c) in self.engine.cell_ids().enumerate() {
             row[c.index()] = k;
         }
-        Ok(internal
+        let keys: Vec<u64> = internal
             .par_iter()
-            .map(|&w| row[self.engine.locate(w).0.index()])
-            .collect())
+            .map(|p| self.space().spatial_key(p))
+            .collect();
+        let mut order: Vec<u32> = (0..points.len() as u32).collect();
+        order.par_sort_unstable_by_key(|&k| keys[k as usize]);
+        let (internal, row) = (&internal, &row);
+        let found: Vec<(u32, usize)> = order
+            .par_chunks(4096)
+            .flat_map_iter(|chunk| {
+                let mut from = None;
+                chunk.iter().map(move |&k| {
+                    let w = internal[k as usize];
+                    let at = match from {
+                        Some(f) => self.engine.locate_from_cell(w, f),
+                        None => self.engine.locate(w),
+                    };
+                    from = Some(at);
+                    (k, row[at.0.index()])
+                })
+            })
+            .collect();
+        let mut out = vec![0; points.len()];
+        for (k, r) in found {
+            out[k as usize] = r;
+        }
+        Ok(out)
     }
 
     /// Checks combinatorics and geometry exactly.

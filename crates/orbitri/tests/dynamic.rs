@@ -6,7 +6,9 @@
 use std::collections::BTreeSet;
 
 use orbitri::sort::SplitMix;
-use orbitri::{Copies, Error, FlatManifold, FlatSpace, FlatTorus, InputId, Removal, Triangulation};
+use orbitri::{
+    Copies, Error, FlatManifold, FlatSpace, FlatTorus, InputId, PointId, Removal, Triangulation,
+};
 use proptest::prelude::*;
 
 mod common;
@@ -145,15 +147,20 @@ fn removals_equal_a_fresh_build_of_the_survivors() {
 #[test]
 fn removal_down_to_nothing_and_back() {
     for (name, torus) in tori3().into_iter().take(2) {
-        let pts = random(60, 4, [1.0; 3]);
+        // enough points for the build to start in the quotient (dummy points)
+        let n = 1100;
+        let pts = random(n, 4, [1.0; 3]);
         let mut tri = Triangulation::<3, 4, _>::build(torus, &pts).unwrap();
+        assert_eq!(tri.sheets(), 1, "{name}");
         let mut sheets = BTreeSet::new();
-        for i in (0..60).rev() {
+        for i in (0..n).rev() {
             tri.remove(InputId::new(i)).unwrap();
-            sheets.insert(tri.sheets());
-            if i % 7 == 0 {
+            if i > 0 {
+                sheets.insert(tri.sheets());
+            }
+            if [1000, 600, 300, 40, 20, 9, 3].contains(&i) {
                 same_as_fresh(&tri, name);
-            } else {
+            } else if i % 101 == 0 || i < 30 {
                 tri.is_valid().unwrap_or_else(|e| panic!("{name}: {e}"));
             }
         }
@@ -162,7 +169,8 @@ fn removal_down_to_nothing_and_back() {
             sheets.len() > 1,
             "{name}: went back to the covering ({sheets:?})"
         );
-        assert!(tri.removal_rebuilds() > 0);
+        // the quotient went back up once; the covering of level 0 then removed in place
+        assert_eq!(tri.removal_rebuilds(), 1, "{name}");
         for p in &pts[..20] {
             tri.insert(*p).unwrap();
         }
@@ -241,6 +249,24 @@ fn moves_keep_ids_and_equal_a_fresh_build() {
     tri.move_point(InputId(3), [0.123, 0.456, 0.789]).unwrap();
     assert_eq!((tri.duplicates(), tri.number_of_vertices()), (0, n));
     assert!(same_as_fresh(&tri, "duplicates"));
+    // onto the point stored last, and the point stored last onto another: the last
+    // point's slot moves, and every input keeps its coordinates
+    let last = |tri: &Triangulation<3, 4, _>| {
+        tri.input_of_vertex(PointId::new(tri.number_of_vertices() - 1))
+    };
+    let (a, b) = (InputId(10), last(&tri));
+    tri.move_point(a, tri.point(tri.vertex_of_input(b)))
+        .unwrap();
+    assert_eq!(tri.vertex_of_input(a), tri.vertex_of_input(b));
+    let (c, d) = (last(&tri), InputId(11));
+    let want = tri.point(tri.vertex_of_input(d));
+    tri.move_point(c, want).unwrap();
+    assert_eq!(tri.vertex_of_input(c), tri.vertex_of_input(d));
+    assert_eq!(tri.point(tri.vertex_of_input(c)), want);
+    assert_eq!((tri.duplicates(), tri.number_of_vertices()), (2, n - 2));
+    assert!(same_as_fresh(&tri, "duplicates of the last point"));
+    // the 1-sheeted quotient held through all of it: no move needed the covering
+    assert_eq!(tri.removal_rebuilds(), 0);
 }
 
 #[test]
@@ -310,6 +336,11 @@ fn bad_ids_and_coordinates_change_nothing() {
             ..
         })
     ));
+    let e = tri.move_all(&[InputId(3), InputId(4)], &[[0.5; 3]]);
+    assert_eq!(
+        e.unwrap_err().to_string(),
+        "number of target points 1 is out of range: must equal the number of ids, 2"
+    );
     assert!(geometry(&tri) == before);
     let fast = tri
         .move_all(&[InputId(3), InputId(4)], &[[0.5; 3], [0.25; 3]])
@@ -420,4 +451,71 @@ fn find_simplex_rows_are_locate_cells() {
             ..
         }
     ));
+}
+
+/// Points inserted one at a time in random order (each walk starting from the jump-and-walk
+/// grid), then removed, inserted and moved, give the bulk build's cells; `find_simplex`
+/// returns, for every query, a cell that contains it (checked with plain orientations of
+/// the cell's vertex positions, translated by small lattice vectors).
+#[test]
+fn any_order_insertion_and_location() {
+    for (name, torus) in tori3() {
+        // (uniform in each domain: a cuboid's points from the unit cube would leave a slab
+        // empty, and keep the triangulation in the covering)
+        let scale = if name == "cuboid" {
+            [1.0, 0.75, 1.5]
+        } else {
+            [1.0; 3]
+        };
+        let pts = random(3000, 21, scale);
+        let mut tri = Triangulation::<3, 4, _>::new(torus.clone());
+        for p in &pts {
+            tri.insert(*p).unwrap();
+        }
+        let bulk = Triangulation::<3, 4, _>::build(torus.clone(), &pts).unwrap();
+        assert!(geometry(&tri) == geometry(&bulk), "{name}: random order");
+        for i in (0..3000).step_by(3) {
+            tri.remove(InputId::new(i)).unwrap();
+        }
+        for p in random(400, 22, scale) {
+            tri.insert(p).unwrap();
+        }
+        let mut r = SplitMix::new(23);
+        for i in (1..3000).step_by(6) {
+            let to = scale.map(|l| r.unit() * l);
+            tri.move_point(InputId::new(i), to).unwrap();
+        }
+        assert!(same_as_fresh(&tri, name));
+        let queries = random(300, 24, scale);
+        let rows = tri.find_simplex(&queries).unwrap();
+        let cells = tri.cells(Copies::Stored);
+        let orient = |a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3]| {
+            let (u, v, w) = (
+                [b[0] - a[0], b[1] - a[1], b[2] - a[2]],
+                [c[0] - a[0], c[1] - a[1], c[2] - a[2]],
+                [d[0] - a[0], d[1] - a[1], d[2] - a[2]],
+            );
+            u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0])
+                + u[2] * (v[0] * w[1] - v[1] * w[0])
+        };
+        for (q, &k) in queries.iter().zip(&rows) {
+            let cell = &cells[k];
+            let inside = (0..125).any(|t: i32| {
+                let t = [t % 5 - 2, t / 5 % 5 - 2, t / 25 - 2];
+                let x: Vec<[f64; 3]> = (0..4)
+                    .map(|i| {
+                        let o = std::array::from_fn(|c| cell.offsets[i][c] - t[c] as i8);
+                        tri.position(cell.vertices[i], o)
+                    })
+                    .collect();
+                let whole = orient(x[0], x[1], x[2], x[3]);
+                (0..4).all(|i| {
+                    let mut y = [x[0], x[1], x[2], x[3]];
+                    y[i] = *q;
+                    orient(y[0], y[1], y[2], y[3]) >= -1e-12 * whole.abs()
+                })
+            });
+            assert!(inside, "{name}: query {q:?} is not in cell {k}");
+        }
+    }
 }

@@ -71,6 +71,9 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.hint = CellId::NONE;
         self.hint_shift = self.space.identity();
         self.copy_hints.clear();
+        if self.one_sheeted {
+            self.refill_locator();
+        }
     }
 
     /// Triangulates the current points from scratch by gift wrapping in the space of
@@ -213,24 +216,34 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.hint = CellId(0);
     }
 
-    /// Drops the points whose vertices were removed (`gone`, 1-sheeted) and renumbers the
-    /// rest in order, in one pass over the cells. Returns each old point's new id
+    /// Drops the points whose vertices were removed (`gone`) and renumbers the rest in
+    /// order, in one pass over the cells. Returns each old point's new id
     /// ([`PointId::NONE`] for the dropped ones).
     pub(crate) fn compact(&mut self, gone: &[bool]) -> Vec<PointId> {
-        debug_assert!(self.one_sheeted);
         let map = renumbering(gone);
+        let sheets = self.copies.len().max(1) as u32;
+        let vertex_gone: Vec<bool> = gone
+            .iter()
+            .flat_map(|&g| std::iter::repeat_n(g, sheets as usize))
+            .collect();
         drop_gone(&mut self.points, gone);
-        drop_gone(&mut self.vcell, gone);
-        self.vpoint = (0..self.points.len() as u32).map(PointId).collect();
+        drop_gone(&mut self.vcell, &vertex_gone);
+        self.vpoint = (0..self.points.len() as u32)
+            .flat_map(|p| std::iter::repeat_n(PointId(p), sheets as usize))
+            .collect();
         for c in 0..self.tds.cells.len() as u32 {
             let c = CellId(c);
             if self.tds.is_alive(c) {
                 for v in self.tds.cells[c.index()].v.iter_mut() {
-                    *v = VertexId(map[v.index()].0);
+                    *v = VertexId(map[(v.0 / sheets) as usize].0 * sheets + v.0 % sheets);
                 }
             }
         }
         self.hint = CellId::NONE;
+        self.copy_hints.clear();
+        if self.one_sheeted {
+            self.refill_locator();
+        }
         map
     }
 

@@ -58,11 +58,21 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         found
     }
 
-    /// The cell containing the point (at the identity), walking from the last insertion;
-    /// it only reads the triangulation, so queries may run in parallel.
+    /// The cell containing the point (at the identity), walking from a vertex near it (the
+    /// jump-and-walk grid) or else from the last insertion; it only reads the
+    /// triangulation, so queries may run in parallel.
     pub fn locate(&self, p: S::Point) -> (CellId, S::Elem) {
-        let (start, shift) = self.start_cell();
+        let (start, shift) = self
+            .jump(self.space.spatial_key(&p))
+            .unwrap_or_else(|| self.start_cell());
         self.walk((p, shift), start, &mut SplitMix::new(0x10ca7e))
+    }
+
+    /// The cell containing the point (at the identity), walking from `from`, a cell near
+    /// it and the shift that lifts it there (see [`Self::walk`]): consecutive queries of
+    /// a spatially sorted batch each start from the previous answer.
+    pub fn locate_from_cell(&self, p: S::Point, from: (CellId, S::Elem)) -> (CellId, S::Elem) {
+        self.walk((p, from.1), from.0, &mut SplitMix::new(0x10ca7e))
     }
 
     /// Collects the cells whose circumsphere contains `q` (starting at `c0`, which contains
@@ -205,13 +215,16 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     }
 
     /// Inserts the lifted point `q` of point `point` as vertex `x`, or says why not.
+    /// The walk starts at `from` (a cell and the shift that lifts `q` into its frame) or,
+    /// without it, from the last insertion.
     pub(crate) fn insert_lifted(
         &mut self,
         q: LiftedOf<S, N>,
         x: VertexId,
         check_duplicate: bool,
+        from: Option<(CellId, S::Elem)>,
     ) -> Result<(), Refused> {
-        let (start, shift) = self.start_cell();
+        let (start, shift) = from.unwrap_or_else(|| self.start_cell());
         let (c, qo) = self.locate_from((q.0, self.space.compose(shift, q.1)), start);
         if check_duplicate {
             for i in 0..N {
@@ -240,15 +253,18 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         }
         let pi = PointId::new(self.points.len());
         if self.one_sheeted {
+            let key = self.space.spatial_key(&p);
+            let from = self.insertion_start(key);
             self.points.push(p);
             self.vpoint.push(pi);
             self.vcell.push(CellId::NONE);
             // once 1-sheeted, the vertex of a point has its id
-            match self.insert_lifted((p, self.space.identity()), VertexId(pi.0), true) {
+            match self.insert_lifted((p, self.space.identity()), VertexId(pi.0), true, from) {
                 Ok(()) => {
                     if !self.guaranteed && self.big_count == 0 {
                         self.set_guaranteed(true);
                     }
+                    self.note_vertex(VertexId(pi.0), key);
                     Inserted::New(pi)
                 }
                 Err(refused) => {
@@ -278,7 +294,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                         (self.hint, self.hint_shift) = (c, shift);
                     }
                 }
-                let inserted = self.insert_lifted((p, o), x, k == 0);
+                let inserted = self.insert_lifted((p, o), x, k == 0, None);
                 let here = (
                     self.hint,
                     self.tds.cells[self.hint.index()].v,

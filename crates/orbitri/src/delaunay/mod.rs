@@ -8,6 +8,7 @@
 
 mod covering;
 mod insert;
+mod locator;
 mod remove;
 mod validate;
 mod wrap;
@@ -18,7 +19,7 @@ use crate::sort::SplitMix;
 use crate::space::{Lifted, OrbitSpace};
 use crate::tds::{Cell, Tds};
 
-pub use remove::Removal;
+pub use remove::{Moved, Removal};
 pub use validate::Invalid;
 
 /// A lifted point of the space `S` (cells of `N` vertices).
@@ -97,6 +98,8 @@ pub struct Engine<S: OrbitSpace<N>, const N: usize> {
     hint_shift: S::Elem,
     rng: SplitMix,
     scratch: Scratch<S::Elem>,
+    /// Jump-and-walk grid of the 1-sheeted triangulation.
+    locator: locator::Locator,
 }
 
 impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
@@ -120,6 +123,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             copy_hints: Vec::new(),
             rng: SplitMix::new(0x5eed),
             scratch: Scratch::default(),
+            locator: locator::Locator::default(),
         };
         e.clear();
         e

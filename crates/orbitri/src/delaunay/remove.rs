@@ -8,6 +8,7 @@
 use std::borrow::Cow;
 
 use super::covering::{drop_gone, renumbering};
+use super::insert::Refused;
 use super::wrap::{Owner, Wrapped};
 use super::{Candidate, Engine, LiftedCell};
 use crate::ids::{CellId, PointId, VertexId};
@@ -22,6 +23,24 @@ pub enum Removal {
     /// The quotient would not have stayed a simplicial complex, or the triangulation was
     /// in a covering: the remaining points were triangulated again from the covering.
     Rebuilt,
+}
+
+/// How a point moved ([`Engine::move_point`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Moved {
+    /// Only its coordinates changed: the cells around it stayed Delaunay.
+    Coordinates,
+    /// Its vertex was removed and inserted again at the new place, keeping its id.
+    Reinserted,
+    /// It landed on another point: it left the triangulation (the last point took its id,
+    /// as in [`Engine::remove_point`]), and this is the id of the point it coincides with.
+    Duplicate(PointId),
+    /// Its star became too large for the quotient without the criterion: every point was
+    /// triangulated again from the covering, the moved one with its id.
+    Rebuilt,
+    /// Not moved in place (the triangulation lives in a covering, or removing the vertex
+    /// would break the quotient): nothing changed; remove and insert instead.
+    Refused,
 }
 
 /// Why a removal was refused.
@@ -41,7 +60,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             self.clear();
             return Removal::InPlace;
         }
-        if self.one_sheeted && self.remove_vertex(self.vertex_of_point(p)).is_ok() {
+        if self.remove_copies(p) {
             // (the walk hint stays on the new cells, where a moved point comes back)
             self.renumber_last_point(p);
             return Removal::InPlace;
@@ -51,7 +70,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         Removal::Rebuilt
     }
 
-    /// Removes the points `ps` (distinct), in that order: in place while the quotient allows,
+    /// Removes the points `ps` (distinct), in that order: in place while the space allows,
     /// then, if one would break it, from the covering with the rest. The points left are
     /// renumbered in order once at the end (one pass over the cells, instead of one star per
     /// removal); returns each old point's new id ([`PointId::NONE`] for the removed) and
@@ -59,10 +78,10 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     pub fn remove_points(&mut self, ps: &[PointId]) -> (Vec<PointId>, bool) {
         let n = self.points.len();
         let mut gone = vec![false; n];
-        let mut rebuild = !self.one_sheeted;
+        let mut rebuild = false;
         for &p in ps {
             gone[p.index()] = true;
-            if !rebuild && self.remove_vertex(self.vertex_of_point(p)).is_err() {
+            if ps.len() < n && !rebuild && !self.remove_copies(p) {
                 rebuild = true;
             }
         }
@@ -80,21 +99,78 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         (map, true)
     }
 
-    /// After the vertex of point `p` was removed from the 1-sheeted triangulation: the last
-    /// point moves into its slot, its vertex renamed in the cells around it.
+    /// Removes every vertex of point `p` (one per sheet), which must not be the only point.
+    /// False when the space does not allow it in place: the quotient would stop being a
+    /// simplicial complex, or a covering above level 0 would lose its criterion. Then the
+    /// triangulation is left unchanged (1-sheeted) or half done (a covering): the caller
+    /// triangulates the remaining points again.
+    fn remove_copies(&mut self, p: PointId) -> bool {
+        if self.one_sheeted {
+            return self.remove_vertex(self.vertex_of_point(p)).is_ok();
+        }
+        let sheets = self.space.sheets(self.level) as u32;
+        (0..sheets).all(|s| self.remove_vertex(VertexId(p.0 * sheets + s)).is_ok())
+    }
+
+    /// After the vertices of point `p` were removed: the last point moves into its slot,
+    /// each of its vertices (one per sheet) renamed in the cells around it.
     fn renumber_last_point(&mut self, p: PointId) {
         let last = self.points.len() - 1;
+        let sheets = if self.one_sheeted {
+            1
+        } else {
+            self.space.sheets(self.level)
+        };
         if p.index() != last {
-            let (from, to) = (VertexId(last as u32), VertexId(p.0));
-            for (c, k, _) in self.star(from) {
-                self.tds.cells[c.index()].v[k] = to;
+            for k in 0..sheets {
+                let from = VertexId::new(last * sheets + k);
+                let to = VertexId::new(p.index() * sheets + k);
+                for (c, i, _) in self.star(from) {
+                    self.tds.cells[c.index()].v[i] = to;
+                }
+                self.vcell[to.index()] = self.vcell[from.index()];
             }
-            self.vcell[p.index()] = self.vcell[last];
             self.points[p.index()] = self.points[last];
         }
         self.points.pop();
-        self.vpoint.pop();
-        self.vcell.pop();
+        self.vpoint.truncate(last * sheets);
+        self.vcell.truncate(last * sheets);
+    }
+
+    /// Moves point `p` to `to` (a canonical point of the domain), keeping its id: by
+    /// changing its coordinates alone when the cells around it stay Delaunay
+    /// ([`Self::try_move`]), else in the 1-sheeted triangulation by removing its vertex and
+    /// inserting it again from the cells that filled the hole, where the walk is short.
+    pub fn move_point(&mut self, p: PointId, to: S::Point) -> Moved {
+        if self.try_move(p, to) {
+            self.note_vertex(self.vertex_of_point(p), self.space.spatial_key(&to));
+            return Moved::Coordinates;
+        }
+        let v = self.vertex_of_point(p);
+        if !self.one_sheeted || self.points.len() == 1 || self.remove_vertex(v).is_err() {
+            return Moved::Refused;
+        }
+        self.points[p.index()] = to;
+        // (the walk starts from the cells that filled the hole)
+        match self.insert_lifted((to, self.space.identity()), v, true, None) {
+            Ok(()) => {
+                if !self.guaranteed && self.big_count == 0 {
+                    self.set_guaranteed(true);
+                }
+                self.note_vertex(v, self.space.spatial_key(&to));
+                Moved::Reinserted
+            }
+            Err(Refused::Duplicate(w)) => {
+                let last = PointId::new(self.points.len() - 1);
+                let q = self.point_of(w);
+                self.renumber_last_point(p);
+                Moved::Duplicate(if q == last { p } else { q })
+            }
+            Err(Refused::NotSimplicial) => {
+                self.rebuild_in_covering();
+                Moved::Rebuilt
+            }
+        }
     }
 
     /// Moves point `p` to `to` (a canonical point of the domain) by changing its
@@ -139,11 +215,12 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         delaunay
     }
 
-    /// Removes vertex `v` of a 1-sheeted triangulation. When the new cells break the switch
-    /// criterion, or it already does not hold, the removal goes ahead only if the quotient
-    /// stays a simplicial complex (Theorem 2.2.8); otherwise nothing changes.
+    /// Removes vertex `v`. In the quotient, when the new cells break the switch criterion,
+    /// or it already does not hold, the removal goes ahead only if the quotient stays a
+    /// simplicial complex (Theorem 2.2.8); in a covering above level 0, only if they keep
+    /// the criterion of its level (level 0 is a triangulation for every point set that
+    /// keeps a copy of each other point). Otherwise nothing changes.
     pub(crate) fn remove_vertex(&mut self, v: VertexId) -> Result<(), RemoveError> {
-        debug_assert!(self.one_sheeted);
         let star = self.star(v);
         let shifted = |e: &Self, c: CellId, shift: S::Elem| -> LiftedCell<S, N> {
             e.lifted_cell(c)
@@ -176,11 +253,16 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         let cells = self
             .wrap(seeds, |_, _, _| Cow::Borrowed(&hole[..]), Vec::new(), false)
             .ok_or(RemoveError::NotSimplicial)?;
-        let limit = self.space.criterion_radius2(self.last_level());
-        let breaks = cells
-            .iter()
-            .any(|w| self.space.circumradius2(&w.arr) >= limit);
-        if breaks || !self.guaranteed {
+        let limit = self.space.criterion_radius2(self.level);
+        let breaks = limit.is_finite()
+            && cells
+                .iter()
+                .any(|w| self.space.circumradius2(&w.arr) >= limit);
+        if !self.one_sheeted {
+            if breaks {
+                return Err(RemoveError::NotSimplicial);
+            }
+        } else if breaks || !self.guaranteed {
             let star_ids: Vec<CellId> = star.iter().map(|s| s.0).collect();
             if !self.removal_keeps_simplicial(&star_ids, &cells) {
                 return Err(RemoveError::NotSimplicial);

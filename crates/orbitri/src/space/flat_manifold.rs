@@ -996,6 +996,8 @@ where
         }
     }
 
+    const KEY_BITS: u32 = if D == 3 { 63 } else { 32 };
+
     fn spatial_key(&self, p: &P<D>) -> u64 {
         let bits = if D == 3 { 21 } else { 16 };
         let f = match &self.lattice_frame {

@@ -133,18 +133,21 @@ impl<const D: usize> FlatTorus<D> {
         lifted_diff(&self.lattice.rows, &a.0, widen(a.1), &b.0, widen(b.1)).0
     }
 
-    /// The circumcenter of a lifted simplex relative to its vertex 0, certified (see
-    /// [`OrbitSpace::circumcenter`](super::OrbitSpace::circumcenter)). `polynomials` gives
-    /// the numerator and the determinant of `x = numerator / (2·det)` from the edge vectors
+    /// The circumcenter of a lifted simplex relative to its vertex 0, certified to within
+    /// `tolerance` of its magnitude and of the simplex's extent (see
+    /// [`OrbitSpace::circumcenter`](super::OrbitSpace::circumcenter): [`CENTER_TOLERANCE`];
+    /// the criterion's radii need far less, [`RADIUS_TOLERANCE`]). `polynomials` gives the
+    /// numerator and the determinant of `x = numerator / (2·det)` from the edge vectors
     /// (rows, from vertex 0); `exact` the same on exact integers.
     pub(super) fn certified_center<const N: usize>(
         &self,
         s: &[L<D>; N],
+        tolerance: f64,
         polynomials: CenterPolynomials<D>,
         exact: impl Fn(&[[BigInt; D]; D]) -> ([BigInt; D], BigInt),
     ) -> [f64; D] {
         let (d, b) = self.rows(std::array::from_fn(|i| &s[i + 1]), &s[0]);
-        if let Some(x) = filtered_center(&d, &b, polynomials) {
+        if let Some(x) = filtered_center(&d, &b, tolerance, polynomials) {
             return x;
         }
         let (l, e) = self.exact_lift_scaled(s);
@@ -434,7 +437,13 @@ pub(super) type CenterPolynomials<const D: usize> =
 
 /// A circumcenter accepted when its certified error is below this fraction of its
 /// magnitude and of the simplex's extent.
-const CENTER_TOLERANCE: f64 = 1.0 / (1u64 << 44) as f64;
+pub(super) const CENTER_TOLERANCE: f64 = 1.0 / (1u64 << 44) as f64;
+
+/// The same for a circumradius compared with the switch criterion, whose radii carry a
+/// relative margin of `1e-7`: since the circumradius is at least half the extent, an error
+/// of `2^-30` of both bounds the radius's relative error by `2√D·2^-30 < 1e-8`. Slivers,
+/// whose circumcenters fail the tight tolerance, mostly pass this one without big integers.
+pub(super) const RADIUS_TOLERANCE: f64 = 1.0 / (1u64 << 30) as f64;
 
 /// The floating-point circumcenter when its error bound allows, else `None`.
 ///
@@ -447,6 +456,7 @@ const CENTER_TOLERANCE: f64 = 1.0 / (1u64 << 44) as f64;
 fn filtered_center<const D: usize>(
     d: &[[f64; D]; D],
     b: &[f64; D],
+    tolerance: f64,
     polynomials: CenterPolynomials<D>,
 ) -> Option<[f64; D]> {
     const U: f64 = f64::EPSILON / 2.0;
@@ -477,8 +487,7 @@ fn filtered_center<const D: usize>(
         x[k] = num[k] / den;
         let q = x[k].abs() * (1.0 + U);
         let bound = 2.0 * U * q + (err(num0[k], num1[k]) + q * err_den) / (den.abs() - err_den);
-        if !x[k].is_finite() || bound.is_nan() || bound > CENTER_TOLERANCE * x[k].abs().max(extent)
-        {
+        if !x[k].is_finite() || bound.is_nan() || bound > tolerance * x[k].abs().max(extent) {
             return None;
         }
     }

@@ -4,7 +4,9 @@
 
 use num_bigint::BigInt;
 
-use super::flat_torus::{flat_torus_plugin, UnperturbedInSphere, L};
+use super::flat_torus::{
+    flat_torus_plugin, UnperturbedInSphere, CENTER_TOLERANCE, L, RADIUS_TOLERANCE,
+};
 use super::{FlatTorus, OrbitSpace};
 use crate::predicates::exact;
 use crate::predicates::filter;
@@ -13,6 +15,20 @@ use crate::predicates::Sign;
 type L2 = L<2>;
 
 impl FlatTorus<2> {
+    /// The circumcenter relative to vertex 0, certified to within `tolerance` (see
+    /// [`FlatTorus::certified_center`]).
+    fn center_within(&self, s: &[L2; 3], tolerance: f64) -> [f64; 2] {
+        self.certified_center(s, tolerance, center_polynomials, |d| {
+            let l = d.each_ref().map(|r| &r[0] * &r[0] + &r[1] * &r[1]);
+            let det = &d[0][0] * &d[1][1] - &d[0][1] * &d[1][0];
+            let num = [
+                &l[0] * &d[1][1] - &l[1] * &d[0][1],
+                &l[1] * &d[0][0] - &l[0] * &d[1][0],
+            ];
+            (num, det)
+        })
+    }
+
     fn orient_exact(&self, s: &[L2; 3]) -> Sign {
         let l = self.exact_lift(s);
         let d: Vec<[BigInt; 2]> = (1..3)
@@ -80,21 +96,15 @@ impl OrbitSpace<3> for FlatTorus<2> {
     }
 
     fn circumradius2(&self, s: &[L2; 3]) -> f64 {
-        let x = self.circumcenter(s);
+        let x = self.center_within(s, RADIUS_TOLERANCE);
         x[0] * x[0] + x[1] * x[1]
     }
 
     fn circumcenter(&self, s: &[L2; 3]) -> [f64; 2] {
-        self.certified_center(s, center_polynomials, |d| {
-            let l = d.each_ref().map(|r| &r[0] * &r[0] + &r[1] * &r[1]);
-            let det = &d[0][0] * &d[1][1] - &d[0][1] * &d[1][0];
-            let num = [
-                &l[0] * &d[1][1] - &l[1] * &d[0][1],
-                &l[1] * &d[0][0] - &l[0] * &d[1][0],
-            ];
-            (num, det)
-        })
+        self.center_within(s, CENTER_TOLERANCE)
     }
+
+    const KEY_BITS: u32 = 32;
 
     fn spatial_key(&self, p: &[f64; 2]) -> u64 {
         // 2^16 cells per axis: far finer than any input's spacing needs for a sort, and half

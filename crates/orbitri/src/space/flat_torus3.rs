@@ -3,7 +3,9 @@
 
 use num_bigint::BigInt;
 
-use super::flat_torus::{flat_torus_plugin, UnperturbedInSphere, L};
+use super::flat_torus::{
+    flat_torus_plugin, UnperturbedInSphere, CENTER_TOLERANCE, L, RADIUS_TOLERANCE,
+};
 use super::{FlatTorus, OrbitSpace};
 use crate::predicates::exact;
 use crate::predicates::filter;
@@ -12,6 +14,31 @@ use crate::predicates::Sign;
 type L3 = L<3>;
 
 impl FlatTorus<3> {
+    /// The circumcenter relative to vertex 0, certified to within `tolerance` (see
+    /// [`FlatTorus::certified_center`]).
+    fn center_within(&self, s: &[L3; 4], tolerance: f64) -> [f64; 3] {
+        self.certified_center(s, tolerance, center_polynomials, |d| {
+            let l = d
+                .each_ref()
+                .map(|r| &r[0] * &r[0] + &r[1] * &r[1] + &r[2] * &r[2]);
+            let cross = |a: &[BigInt; 3], b: &[BigInt; 3]| -> [BigInt; 3] {
+                [
+                    &a[1] * &b[2] - &a[2] * &b[1],
+                    &a[2] * &b[0] - &a[0] * &b[2],
+                    &a[0] * &b[1] - &a[1] * &b[0],
+                ]
+            };
+            let (c12, c20, c01) = (
+                cross(&d[1], &d[2]),
+                cross(&d[2], &d[0]),
+                cross(&d[0], &d[1]),
+            );
+            let det = &d[0][0] * &c12[0] + &d[0][1] * &c12[1] + &d[0][2] * &c12[2];
+            let num = std::array::from_fn(|k| &l[0] * &c12[k] + &l[1] * &c20[k] + &l[2] * &c01[k]);
+            (num, det)
+        })
+    }
+
     fn orient_exact(&self, s: &[L3; 4]) -> Sign {
         let l = self.exact_lift(s);
         let d: Vec<[BigInt; 3]> = (1..4)
@@ -95,32 +122,15 @@ impl OrbitSpace<4> for FlatTorus<3> {
     }
 
     fn circumradius2(&self, s: &[L3; 4]) -> f64 {
-        let x = self.circumcenter(s);
+        let x = self.center_within(s, RADIUS_TOLERANCE);
         x[0] * x[0] + x[1] * x[1] + x[2] * x[2]
     }
 
     fn circumcenter(&self, s: &[L3; 4]) -> [f64; 3] {
-        self.certified_center(s, center_polynomials, |d| {
-            let l = d
-                .each_ref()
-                .map(|r| &r[0] * &r[0] + &r[1] * &r[1] + &r[2] * &r[2]);
-            let cross = |a: &[BigInt; 3], b: &[BigInt; 3]| -> [BigInt; 3] {
-                [
-                    &a[1] * &b[2] - &a[2] * &b[1],
-                    &a[2] * &b[0] - &a[0] * &b[2],
-                    &a[0] * &b[1] - &a[1] * &b[0],
-                ]
-            };
-            let (c12, c20, c01) = (
-                cross(&d[1], &d[2]),
-                cross(&d[2], &d[0]),
-                cross(&d[0], &d[1]),
-            );
-            let det = &d[0][0] * &c12[0] + &d[0][1] * &c12[1] + &d[0][2] * &c12[2];
-            let num = std::array::from_fn(|k| &l[0] * &c12[k] + &l[1] * &c20[k] + &l[2] * &c01[k]);
-            (num, det)
-        })
+        self.center_within(s, CENTER_TOLERANCE)
     }
+
+    const KEY_BITS: u32 = 63;
 
     fn spatial_key(&self, p: &[f64; 3]) -> u64 {
         crate::sort::hilbert(self.grid_cell(p, 21), 21)
@@ -245,5 +255,37 @@ mod tests {
         assert_eq!(off, [[1, 2, 0], [0, 3, 0], [1, 3, 1], [0, 3, 0]]);
         assert_eq!(t.covering_copies(0).len(), 27);
         assert_eq!(t.levels(), 2);
+    }
+
+    /// Slivers: four points near one circle, lifted off its plane by `h`. The circumradius
+    /// (certified to `2^-28`, for the criterion) agrees with the tight circumcenter's, to
+    /// within that, however flat the sliver; the radius tends to the circle's, 0.1.
+    #[test]
+    fn sliver_circumradius() {
+        let t = unit();
+        let z = [0i8; 3];
+        for h in [1e-3, 1e-7, 1e-11, 1e-14] {
+            let s = [
+                ([0.6, 0.5, 0.5], z),
+                ([0.5, 0.6, 0.5 + h], z),
+                ([0.4, 0.5, 0.5], z),
+                ([0.5, 0.4, 0.5 + h], z),
+            ];
+            let r2 = t.circumradius2(&s);
+            let x = t.circumcenter(&s);
+            let tight = x[0] * x[0] + x[1] * x[1] + x[2] * x[2];
+            assert!(
+                ((r2 - tight) / tight).abs() < 2f64.powi(-27),
+                "h = {h}: {r2} vs {tight}"
+            );
+            assert!((r2 - 0.01).abs() < 1e-6, "h = {h}: {r2}");
+        }
+        let flat = [
+            ([0.6, 0.5, 0.5], z),
+            ([0.5, 0.6, 0.5], z),
+            ([0.4, 0.5, 0.5], z),
+            ([0.5, 0.4, 0.5], z),
+        ];
+        assert_eq!(t.circumradius2(&flat), f64::INFINITY);
     }
 }

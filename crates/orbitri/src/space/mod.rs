@@ -80,8 +80,9 @@ pub trait OrbitSpace<const N: usize>: Sync + Send {
         a: Lifted<Self::Point, Self::Elem>,
         b: Lifted<Self::Point, Self::Elem>,
     ) -> bool;
-    /// Squared circumradius, to a relative accuracy of about `2^-43` (infinite for a flat
-    /// simplex): from [`OrbitSpace::circumcenter`].
+    /// Squared circumradius, certified to a relative accuracy of about `2^-28` (infinite for
+    /// a flat simplex): enough for the switch criterion, whose radii carry a margin of
+    /// `1e-7`, and cheaper than [`OrbitSpace::circumcenter`] for slivers.
     fn circumradius2(&self, s: &[Lifted<Self::Point, Self::Elem>; N]) -> f64;
     /// The circumcenter of the lifted simplex relative to its vertex 0, in Cartesian
     /// coordinates, certified: a floating-point evaluation whose error bound is below
@@ -137,8 +138,12 @@ pub trait OrbitSpace<const N: usize>: Sync + Send {
     /// An upper bound on the length of a Delaunay edge: at level 0 for any non-empty point
     /// set, at a later level under that level's criterion.
     fn edge_bound(&self, level: usize) -> f64;
-    /// A key along a space-filling curve, for spatial sorting.
+    /// A key along a space-filling curve, for spatial sorting: the index along a Hilbert
+    /// curve of `KEY_BITS` bits, whose leading `D·b` bits index the grid of `2^b` cells per
+    /// axis over the domain (the jump-and-walk grid).
     fn spatial_key(&self, p: &Self::Point) -> u64;
+    /// The width of [`OrbitSpace::spatial_key`], at most 63.
+    const KEY_BITS: u32;
 }
 
 /// A flat orbit space as the facade, the Voronoi layer and the writers see it: points

@@ -1,0 +1,103 @@
+//! Jump and walk for queries in any order: a coarse grid over the domain, one vertex per
+//! grid cell, from which a walk starts when a query is far from the last one. The grid
+//! cells are the prefixes of the space's Hilbert keys ([`OrbitSpace::spatial_key`]), so
+//! that about two points share one; a walk from a vertex of the query's own grid cell takes
+//! a few steps whatever `n`, where a walk from the last insertion crosses `n^(1/D)` cells.
+//!
+//! The grid is a cache, never trusted: an entry is used only if its vertex still exists
+//! and its point still lies in that grid cell, so removals, renumberings and moves need no
+//! bookkeeping beyond an occasional refill.
+
+use super::Engine;
+use crate::ids::{CellId, VertexId};
+use crate::space::OrbitSpace;
+
+/// The grid: `slots[key >> shift]` is a vertex whose point had that key prefix.
+#[derive(Debug, Default)]
+pub(super) struct Locator {
+    shift: u32,
+    slots: Vec<VertexId>,
+    /// The number of points when the grid was sized: refilled at twice that.
+    sized_for: usize,
+    /// The grid cell of the last insertion: the next one jumps only from another.
+    last: usize,
+}
+
+impl Locator {
+    /// The grid cell of a spatial key.
+    #[inline]
+    fn slot(&self, key: u64) -> usize {
+        (key >> self.shift) as usize
+    }
+}
+
+impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
+    /// Sizes the grid for the current points (about two per grid cell, refinement by whole
+    /// levels of the Hilbert curve) and fills it; 1-sheeted only.
+    pub(super) fn refill_locator(&mut self) {
+        let dim = (N - 1) as u32;
+        let n = self.points.len();
+        let mut bits = 0;
+        while bits < S::KEY_BITS / dim && (1usize << (dim * (bits + 1))) <= n / 2 {
+            bits += 1;
+        }
+        let mut slots = std::mem::take(&mut self.locator.slots);
+        slots.clear();
+        slots.resize(1 << (dim * bits), VertexId::NONE);
+        self.locator = Locator {
+            shift: S::KEY_BITS - dim * bits,
+            slots,
+            sized_for: n.max(1),
+            last: usize::MAX,
+        };
+        for (i, p) in self.points.iter().enumerate() {
+            let k = self.locator.slot(self.space.spatial_key(p));
+            self.locator.slots[k] = VertexId::new(i);
+        }
+    }
+
+    /// Records vertex `v` (1-sheeted), whose point has spatial key `key`, in the grid,
+    /// refilling it when the points have doubled since it was sized.
+    pub(super) fn note_vertex(&mut self, v: VertexId, key: u64) {
+        if self.points.len() >= 2 * self.locator.sized_for {
+            self.refill_locator();
+        } else {
+            let k = self.locator.slot(key);
+            self.locator.slots[k] = v;
+        }
+    }
+
+    /// Where an insertion of a point with spatial key `key` starts walking: from the grid
+    /// when the point is in another grid cell than the last insertion's (spatially sorted
+    /// insertions keep walking from the last one, whose cells are in cache).
+    pub(super) fn insertion_start(&mut self, key: u64) -> Option<(CellId, S::Elem)> {
+        let k = self.locator.slot(key);
+        if std::mem::replace(&mut self.locator.last, k) == k {
+            return None;
+        }
+        self.jump(key)
+    }
+
+    /// A cell near the point with spatial key `key`, and the shift that lifts the point
+    /// into its frame: from the grid when its entry is still good, else `None`.
+    pub(super) fn jump(&self, key: u64) -> Option<(CellId, S::Elem)> {
+        if !self.one_sheeted {
+            return None;
+        }
+        let k = self.locator.slot(key);
+        let v = *self.locator.slots.get(k)?;
+        let c = *self.vcell.get(v.index())?;
+        if c == CellId::NONE
+            || self
+                .locator
+                .slot(self.space.spatial_key(&self.points[v.index()]))
+                != k
+        {
+            return None;
+        }
+        let cell = &self.tds.cells[c.index()];
+        let i = cell.index_of(v)?;
+        // the query, near the vertex's point, is lifted like the vertex in this cell
+        Some((c, cell.off[i]))
+    }
+}
