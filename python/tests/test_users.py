@@ -2,8 +2,6 @@
 expect back, tested against those packages themselves: boxes as they write them, their
 systems, neighbour lists, tables, pictures and files."""
 
-import os
-import pathlib
 import subprocess
 
 import numpy as np
@@ -19,18 +17,7 @@ import MDAnalysis as mda
 from MDAnalysis.lib.mdamath import triclinic_vectors
 import pandas as pd
 
-ROOT = pathlib.Path(__file__).resolve().parents[2]
-
-
-def _cli():
-    exe = os.environ.get("ORBITRI_BIN")
-    if exe:
-        return exe
-    for profile in ("release", "debug"):
-        p = ROOT / "target" / profile / "orbitri"
-        if p.exists():
-            return str(p)
-    raise RuntimeError("build the command first: cargo build -p orbitri-cli (or set ORBITRI_BIN)")
+from test_orbitri import _cli  # noqa: E402
 
 
 def _fcc(n, a=0.1):

@@ -1059,54 +1059,44 @@ fn draw_shows_the_klein_bottle_with_its_glide_images() {
     );
 }
 
+/// Runs the command with the blank-separated words of `line` (paths without blanks).
+fn run_line(line: &str) -> std::process::Output {
+    orbitri(&line.split_whitespace().collect::<Vec<_>>())
+}
+
 #[test]
 fn output_formats_come_from_known_extensions_only() {
     let dir = tempfile::tempdir().unwrap();
     let input = generated(dir.path(), 40, 2, 3);
     let input = input.to_str().unwrap();
-    let out = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
+    let d = dir.path().to_str().unwrap();
     for (command, name, message) in [
         ("voronoi", "v.txt", "v.txt: cannot tell the output format from the extension .txt: use .csv, .npy, .npz, .json, .vtu or give --format"),
         ("voronoi", "v", "cannot tell the output format from a name without extension"),
         ("triangulate", "t.out", "use .cells, .json, .vtu, .txt or give --format"),
         ("draw", "d.jpg", "d.jpg: draw writes .svg or .png pictures, not .jpg"),
     ] {
-        let o = orbitri(&[command, input, "--box", "1", "1", "-o", &out(name)]);
+        let o = run_line(&format!("{command} {input} --box 1 1 -o {d}/{name}"));
         assert_eq!(o.status.code(), Some(2), "{command} {name}");
         assert!(stderr(&o).contains(message), "{}", stderr(&o));
         assert!(!dir.path().join(name).exists(), "{name} was written");
     }
     // --format names it whatever the extension; .txt is the cells format
-    let o = orbitri(&[
-        "voronoi",
-        input,
-        "--box",
-        "1",
-        "1",
-        "-o",
-        &out("v.txt"),
-        "--format",
-        "csv",
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let o = orbitri(&["triangulate", input, "--box", "1", "1", "-o", &out("t.txt")]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let cells = std::fs::read_to_string(out("t.txt")).unwrap();
+    for line in [
+        format!("voronoi {input} --box 1 1 -o {d}/v.txt --format csv"),
+        format!("triangulate {input} --box 1 1 -o {d}/t.txt"),
+        format!("voronoi {input} --box 1 1 -o {d}/v.npz"),
+    ] {
+        let o = run_line(&line);
+        assert!(o.status.success(), "{line}: {}", stderr(&o));
+    }
+    let cells = std::fs::read_to_string(dir.path().join("t.txt")).unwrap();
     assert!(cells.starts_with("1 40 80\n"), "{cells}");
     // .npz: named arrays in a zip archive
-    let o = orbitri(&["voronoi", input, "--box", "1", "1", "-o", &out("v.npz")]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let z = std::fs::read(out("v.npz")).unwrap();
+    let z = std::fs::read(dir.path().join("v.npz")).unwrap();
     assert_eq!(&z[..4], b"PK\x03\x04");
     let text = String::from_utf8_lossy(&z);
-    for name in [
-        "id",
-        "volume",
-        "neighbours",
-        "surface_area",
-        "centroid",
-        "duplicate_of",
-    ] {
+    for name in "id volume neighbours surface_area centroid duplicate_of".split(' ') {
         assert!(text.contains(&format!("{name}.npy")), "{name}");
     }
 }
@@ -1117,81 +1107,33 @@ fn cellpar_gives_lengths_and_angles() {
     let input = generated(dir.path(), 300, 3, 4);
     let input = input.to_str().unwrap();
     // a hexagonal prism cell: a = b = 1, c = 2, γ = 120°; the volumes sum to its volume
-    let o = orbitri(&[
-        "voronoi",
-        input,
-        "--cellpar",
-        "1",
-        "1",
-        "2",
-        "90",
-        "90",
-        "120",
-        "--stats",
-    ]);
+    let o = run_line(&format!(
+        "voronoi {input} --cellpar 1 1 2 90 90 120 --stats"
+    ));
     assert!(o.status.success(), "{}", stderr(&o));
     let err = stderr(&o);
-    let domain: f64 = err
-        .split("domain_volume=")
-        .nth(1)
-        .unwrap()
-        .split(' ')
-        .next()
-        .unwrap()
-        .parse()
-        .unwrap();
+    let domain = err.split("domain_volume=").nth(1).unwrap();
+    let domain: f64 = domain.split(' ').next().unwrap().parse().unwrap();
     assert!((domain - 3f64.sqrt()).abs() < 1e-12, "{err}");
     // 2D: A B GAMMA, for draw too
     let input2 = generated(dir.path(), 30, 2, 5);
     let svg = dir.path().join("h.svg");
-    let o = orbitri(&[
-        "draw",
-        input2.to_str().unwrap(),
-        "--cellpar",
-        "1",
-        "1",
-        "60",
-        "-o",
-        svg.to_str().unwrap(),
-    ]);
+    let o = run_line(&format!(
+        "draw {} --cellpar 1 1 60 -o {}",
+        input2.display(),
+        svg.display()
+    ));
     assert!(o.status.success(), "{}", stderr(&o));
-    // six numbers after --box are lengths and angles given to the wrong flag
-    let o = orbitri(&[
-        "voronoi", input, "--box", "10", "10", "10", "90", "90", "90",
-    ]);
-    assert_eq!(o.status.code(), Some(2));
-    assert!(stderr(&o).contains("--box takes the lengths LX LY [LZ], not 6 numbers: for lengths and angles (a b c α β γ) use --cellpar"), "{}", stderr(&o));
-    let o = orbitri(&[
-        "voronoi",
-        input,
-        "--cellpar",
-        "1",
-        "1",
-        "1",
-        "120",
-        "120",
-        "120",
-    ]);
-    assert_eq!(o.status.code(), Some(2));
-    assert!(stderr(&o).contains("make no cell"), "{}", stderr(&o));
-    let o = orbitri(&[
-        "voronoi",
-        input,
-        "--space",
-        "dicosm",
-        "--cellpar",
-        "1",
-        "1",
-        "1",
-        "90",
-        "90",
-        "90",
-    ]);
-    assert!(
-        stderr(&o).contains("--cellpar is for the torus only: --space dicosm takes --box L1 L2 L3"),
-        "{}",
-        stderr(&o)
-    );
+    for (domain, message) in [
+        // six numbers after --box are lengths and angles given to the wrong flag
+        ("--box 10 10 10 90 90 90", "--box takes the lengths LX LY [LZ], not 6 numbers: for lengths and angles (a b c α β γ) use --cellpar"),
+        ("--cellpar 1 1 1 120 120 120", "make no cell"),
+        ("--space dicosm --cellpar 1 1 1 90 90 90", "--cellpar is for the torus only: --space dicosm takes --box L1 L2 L3"),
+    ] {
+        let o = run_line(&format!("voronoi {input} {domain}"));
+        assert_eq!(o.status.code(), Some(2), "{domain}");
+        assert!(stderr(&o).contains(message), "{}", stderr(&o));
+    }
 }
 
 #[test]
