@@ -5,7 +5,8 @@
 //!
 //! The first line with values may be a header, a line none of whose fields is a number (as
 //! pandas' `to_csv` writes): it is skipped. If it names columns `x`, `y` (and `z`), those
-//! are read, in that order, from rows of as many fields as the header has; if its first
+//! are read, in that order, from rows of as many fields as the header has (the other fields
+//! may hold anything but an empty field or a comma); if its first
 //! field is empty (pandas' unnamed index) and it has `D + 1` fields, the first column is
 //! left out; otherwise it must have `D` fields.
 
@@ -179,7 +180,8 @@ fn header_columns<const D: usize>(
     } else {
         body.split_whitespace().collect()
     };
-    if fields.iter().any(|f| f.parse::<f64>().is_ok()) {
+    // names: none a number, only the first (pandas' index) may be empty
+    if fields.iter().any(|f| f.parse::<f64>().is_ok()) || fields[1..].iter().any(|f| f.is_empty()) {
         return Ok(None);
     }
     let n = fields.len();
@@ -277,6 +279,11 @@ mod tests {
         // named columns anywhere, in any order
         let p = parse("id,z,type,x,y\n7,0.3,1,0.1,0.2\n").unwrap();
         assert_eq!(p, vec![[0.1, 0.2, 0.3]]);
+        // the other columns may hold names (an element), not only numbers
+        let p = parse("id,type,x,y,z\n1,Cu,0.1,0.2,0.3\n").unwrap();
+        assert_eq!(p, vec![[0.1, 0.2, 0.3]]);
+        // empty names are no header (but pandas' unnamed index)
+        assert!(error(",,\n0.1,0.2,0.3\n").starts_with("in.txt:1: field 1 is empty"));
         let p = parse_text::<2>("X Y\n0.1 0.2\n", Path::new("in.txt")).unwrap();
         assert_eq!(p, vec![[0.1, 0.2]]);
         // rows must have the header's fields; only the first line may be a header
