@@ -16,5 +16,5 @@ venv=${ORBITRI_WHEEL_VENV:-target/wheel-venv}
 # maturin runs zig as `python3 -m ziglang`: the environment's python3 must come first
 export PATH="$PWD/$venv/bin:$PATH"
 rm -f dist/orbitri-*.whl
-maturin build --release --locked --zig --compatibility manylinux2014 --out dist "$@" >&2
+maturin build --release --locked --strip --zig --compatibility manylinux2014 --out dist "$@" >&2
 ls dist/orbitri-*-cp39-abi3-*manylinux*.whl

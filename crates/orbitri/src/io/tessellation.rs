@@ -229,6 +229,16 @@ enum Values {
 }
 
 impl Values {
+    /// The zlib level: doubles (coordinates, measures) barely compress (by about 6 %, at
+    /// 5 s for the 65 MB of points of 10⁵ cells), so they are stored; integers (ids, face
+    /// streams) shrink about fivefold at the fastest level.
+    fn compression(&self) -> flate2::Compression {
+        match self {
+            Values::F64(..) => flate2::Compression::none(),
+            _ => flate2::Compression::fast(),
+        }
+    }
+
     /// VTK's type name, the components, and the little-endian bytes.
     fn parts(&self) -> (&'static str, usize, Vec<u8>) {
         match self {
@@ -248,13 +258,13 @@ const VTU_BLOCK: usize = 1 << 20;
 
 /// `bytes` as VTK's zlib-compressed binary: the header `[blocks, block size, size of the
 /// last block (0 if full), compressed size of each block]` (UInt64), then the blocks,
-/// compressed in parallel.
-fn vtk_zlib(bytes: &[u8]) -> Vec<u8> {
+/// compressed in parallel at `level`.
+fn vtk_zlib(bytes: &[u8], level: flate2::Compression) -> Vec<u8> {
     use rayon::prelude::*;
     let blocks: Vec<Vec<u8>> = bytes
         .par_chunks(VTU_BLOCK)
         .map(|b| {
-            let mut z = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::new(4));
+            let mut z = flate2::write::ZlibEncoder::new(Vec::new(), level);
             z.write_all(b).expect("writing to memory");
             z.finish().expect("writing to memory")
         })
@@ -286,7 +296,7 @@ impl Vtu {
                 r#"<DataArray type="{kind}" Name="{name}" NumberOfComponents="{comps}" format="appended" offset="{}"/>"#,
                 data.len()
             );
-            data.extend_from_slice(&vtk_zlib(&bytes));
+            data.extend_from_slice(&vtk_zlib(&bytes, values.compression()));
         };
         let _ = writeln!(
             xml,
