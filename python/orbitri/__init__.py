@@ -127,7 +127,12 @@ class Box:
 
     @classmethod
     def from_matrix(cls, matrix) -> "Box":
-        """The box whose lattice vectors are the rows of ``matrix`` (ASE's ``cell``)."""
+        """The box whose lattice vectors are the rows of ``matrix`` (ASE's ``cell``).
+
+        >>> import orbitri
+        >>> orbitri.Box.from_matrix([[1, 0], [0.5, 1]]).volume
+        1.0
+        """
         return cls(matrix)
 
     @classmethod
@@ -592,7 +597,17 @@ class PeriodicDelaunay(_Delaunay):
     ``PeriodicDelaunay(system)`` takes the points and the box of an ASE ``Atoms`` (its
     ``cell``; every axis must be periodic, ``pbc``, else a ``ValueError`` says which is
     not), an MDAnalysis ``Universe`` or ``AtomGroup`` (the current frame; its
-    ``dimensions`` are lengths and angles) or freud's ``(box, points)``.
+    ``dimensions`` are lengths and angles) or freud's ``(box, points)``:
+
+    >>> import ase.build, orbitri
+    >>> atoms = ase.build.bulk("Cu", "fcc", a=3.6, cubic=True).repeat(3)
+    >>> orbitri.PeriodicDelaunay(atoms)
+    <orbitri.PeriodicDelaunay: 108 points in 3D, 1 sheet, box Box.from_matrix([[10.8, 0.0, 0.0], [0.0, 10.8, 0.0], [0.0, 0.0, 10.8]])>
+    >>> atoms.pbc = [True, True, False]
+    >>> orbitri.PeriodicDelaunay(atoms)
+    Traceback (most recent call last):
+    ...
+    ValueError: the ASE Atoms are not periodic along z (pbc=[True, True, False]); orbitri triangulates periodic boxes: set atoms.pbc = True to make the cell periodic along every axis (a vacuum gap in the cell then stays between the images)
 
     Points outside the box are wrapped into it; a point that coincides with an earlier one
     (also through a period) is a duplicate: it maps to its first occurrence and is listed in
@@ -788,6 +803,10 @@ def periodic_voronoi(points, box=None) -> "Voronoi":
     >>> vor = orbitri.periodic_voronoi(np.random.default_rng(2).random((500, 2)), [1.0, 1.0])
     >>> len(vor), bool(abs(vor.volumes.sum() - 1.0) < 1e-12)
     (500, True)
+    >>> import freud
+    >>> box, points = freud.data.make_random_system(10, 200, seed=1)
+    >>> round(float(orbitri.periodic_voronoi((box, points)).volumes.sum()), 6)
+    1000.0
     """
     return PeriodicDelaunay(points, box).voronoi()
 
@@ -1064,7 +1083,13 @@ class NeighborList:
 
     def to_dataframe(self):
         """The pairs as a ``pandas.DataFrame``: ``i``, ``j``, the shift's (or element's)
-        columns, ``area``, ``distance`` and the vector's columns."""
+        columns, ``area``, ``distance`` and the vector's columns.
+
+        >>> import numpy as np, orbitri
+        >>> vor = orbitri.periodic_voronoi(np.random.default_rng(2).random((100, 2)), [1, 1])
+        >>> list(vor.neighbor_list().to_dataframe().columns)
+        ['i', 'j', 'shift_x', 'shift_y', 'area', 'distance', 'vector_x', 'vector_y']
+        """
         pd = _pandas()
         d = self.vectors.shape[1]
         columns = {"i": self.i, "j": self.j}
