@@ -580,8 +580,13 @@ class _Delaunay:
         True
         """
         pairs = self.edges()[0]
-        both = np.unique(np.concatenate([pairs, pairs[:, ::-1]]), axis=0)
-        return _csr(both[:, 0], both[:, 1], self.number_of_input_points)
+        n = self.number_of_input_points
+        # each ordered pair once, as one sortable key (sorted, then deduplicated: numpy
+        # 2.4's np.unique takes 12 s where this takes 0.2)
+        keys = np.sort(np.concatenate([pairs[:, 0] * n + pairs[:, 1], pairs[:, 1] * n + pairs[:, 0]]))
+        keys = keys[np.concatenate([[True], keys[1:] != keys[:-1]])]
+        rows, columns = np.divmod(keys, n)
+        return _csr(rows, columns, n)
 
     def _describe(self) -> str:
         n = self.number_of_input_points
