@@ -8,6 +8,8 @@ import numpy.typing as npt
 __version__: str
 PLATYCOSMS: list[str]
 
+def cellpar_matrix(p: list[float]) -> npt.NDArray[np.float64]: ...
+
 # A group element array: a torus's offsets (… × D), a manifold's (cosets …, offsets … × D).
 _Elements = npt.NDArray[np.int32] | tuple[npt.NDArray[np.int32], npt.NDArray[np.int32]]
 

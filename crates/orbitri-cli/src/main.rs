@@ -28,29 +28,42 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Triangulate the points of INPUT (text: one `x y z` or `x y` per line, `#` comments,
-    /// commas or blanks; or `.npy`: float64, N×3 or N×2) in a periodic box or lattice, or in
-    /// the closed flat manifold `--space`; the dimension is that of the box.
+    /// Triangulate the points of INPUT in a periodic box or lattice, or in the closed flat
+    /// manifold `--space`; the dimension is that of the box.
+    ///
+    /// Writes the cells (`SHEETS V C`, then per cell its D+1 input ids and their lattice
+    /// offsets), JSON, or VTK for ParaView.
+    ///
+    /// Example: orbitri triangulate points.txt --box 10 10 10 -o cells.txt
     Triangulate {
-        /// Input file (text or .npy)
+        /// Points: text (one `x y z` or `x y` per line; blanks or commas; `#` comments; a
+        /// header line such as pandas' `x,y,z` is skipped) or `.npy` (N×3 or N×2, float or
+        /// integer)
         input: PathBuf,
         #[command(flatten)]
         domain: Domain,
         #[command(flatten)]
         out: Output,
     },
-    /// Compute the periodic Voronoi cell of every point of INPUT: one row per input point
-    /// (`id,volume,neighbours,surface_area,centroid_…,duplicate_of`, input order) as CSV or
-    /// `.npy`, or the whole cells as JSON or VTK (`.vtu`, for ParaView).
+    /// Compute the periodic Voronoi cell of every point of INPUT.
+    ///
+    /// One row per input point (`id,volume,neighbours,surface_area,centroid_…,duplicate_of`,
+    /// input order) as CSV, `.npy` or `.npz` (named arrays), or the whole cells as JSON or
+    /// VTK (`.vtu`, binary, for ParaView).
+    ///
+    /// Example: orbitri voronoi points.txt --cellpar 10 10 10 90 90 120 -o cells.vtu
     Voronoi {
-        /// Input file (text or .npy)
+        /// Points: text (one `x y z` or `x y` per line; blanks or commas; `#` comments; a
+        /// header line such as pandas' `x,y,z` is skipped) or `.npy` (N×3 or N×2, float or
+        /// integer)
         input: PathBuf,
         #[command(flatten)]
         domain: Domain,
-        /// Output file (default: standard output); its extension picks the format
+        /// Output file (default: the CSV table on standard output); its extension, .csv,
+        /// .npy, .npz, .json or .vtu, picks the format, unless --format is given
         #[arg(short = 'o', long)]
         output: Option<PathBuf>,
-        /// Output format (default: from the output's extension, else csv)
+        /// Output format (default: from the output's extension; csv on standard output)
         #[arg(long, value_enum)]
         format: Option<VoronoiFormat>,
         /// Also write the neighbour pairs `i,j,shift…,area` (each pair once) as CSV here
@@ -63,15 +76,18 @@ enum Command {
         #[arg(long)]
         stats: bool,
     },
-    /// Draw the periodic Delaunay triangulation and Voronoi diagram of 2D points over copies
-    /// of the domain (in a Klein bottle: its images, every other column reflected), to SVG
-    /// (or PNG for a `.png` output name).
+    /// Draw the periodic Delaunay triangulation (blue) and Voronoi diagram (red) of 2D points
+    /// over copies of the domain (in a Klein bottle: its images, every other column
+    /// reflected), to SVG or PNG.
+    ///
+    /// Example: orbitri draw points.txt --box 1 1 -o picture.svg
     Draw {
-        /// Input file (text or .npy, 2 coordinates per point)
+        /// 2D points: text (one `x y` per line; blanks or commas; `#` comments; a header line
+        /// is skipped) or `.npy` (N×2)
         input: PathBuf,
         #[command(flatten)]
-        domain: Domain,
-        /// Output file: .svg or .png
+        domain: Domain2,
+        /// Output file: .svg or .png (the extension picks the format)
         #[arg(short = 'o', long)]
         output: PathBuf,
         /// Copies of the domain per lattice direction: at most 50, and at most 2000000 points
@@ -89,26 +105,32 @@ enum Command {
         #[arg(long)]
         no_delaunay: bool,
     },
-    /// Triangulate built-in examples: uniform random points in the unit cube and an FCC
-    /// crystal (every Delaunay sphere degenerate), then the unit square and a hexagonal
-    /// crystal in 2D, with exact validity checks.
+    /// Triangulate built-in examples and check them exactly: uniform random points in the
+    /// unit cube and an FCC crystal (every Delaunay sphere degenerate), then the unit square
+    /// and a honeycomb in 2D. Reads and writes no file.
     Demo {
-        /// Number of random points
+        /// Number of random points (in the cube, then in the square)
         #[arg(short = 'n', long, default_value_t = 100_000)]
         points: usize,
         /// Seed of the point generator
         #[arg(long, default_value_t = 1)]
         seed: u64,
     },
-    /// Write N uniform random points of the unit cube or square (the CGAL anchor harness's
-    /// generator).
+    /// Write N uniform random points of the unit cube or square, one `x y z` (`x y`) per
+    /// line: the CGAL anchor harness's generator, bit for bit, for benchmarks and tests.
+    ///
+    /// Example: orbitri generate 1000 --dim 2 -o points.txt
     Generate {
+        /// How many points
+        #[arg(value_name = "N")]
         n: usize,
+        /// Seed of the generator (SplitMix64): the same seed gives the same points
         #[arg(long, default_value_t = 1)]
         seed: u64,
         /// Dimension: 3 (unit cube) or 2 (unit square)
         #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u8).range(2..=3))]
         dim: u8,
+        /// Output file (default: standard output), text
         #[arg(short = 'o', long)]
         output: Option<PathBuf>,
     },
@@ -129,26 +151,76 @@ struct Domain {
     extent: Extent,
 }
 
+/// The domain of `draw`: 2D only.
+#[derive(Args)]
+struct Domain2 {
+    /// The orbit space: a flat torus (default) or the Klein bottle (--box L1 L2, the glide
+    /// along the first axis)
+    #[arg(long, value_name = "NAME", default_value = "torus", value_parser = PossibleValuesParser::new(TORUS_AND_KLEIN))]
+    space: String,
+    #[command(flatten)]
+    extent: Extent2,
+}
+
 #[derive(Args)]
 #[group(required = true, multiple = false)]
 struct Extent {
-    /// Box lengths: the domain is [0,LX) × [0,LY) × [0,LZ), or [0,LX) × [0,LY) in 2D
-    #[arg(long = "box", num_args = 2..=3, value_names = ["LX", "LY", "LZ"], value_parser = number, allow_negative_numbers = true)]
+    /// Box lengths, 3 or 2: the domain is [0,LX) × [0,LY) × [0,LZ), or [0,LX) × [0,LY)
+    #[arg(long = "box", num_args = 2..=6, value_names = ["LX", "LY", "LZ"], value_parser = number, allow_negative_numbers = true)]
     box_lengths: Option<Vec<f64>>,
     /// Lattice vectors (rows): AX AY AZ BX BY BZ CX CY CZ in 3D, AX AY BX BY in 2D; the
     /// domain is {f·M : f ∈ [0,1)^D}
     #[arg(long, num_args = 4..=9, value_names = ["AX", "AY", "..."], value_parser = number, allow_negative_numbers = true)]
     lattice: Option<Vec<f64>>,
+    /// Cell lengths and angles in degrees (a CIF's, ASE's cellpar, MDAnalysis's
+    /// dimensions): A B C ALPHA BETA GAMMA in 3D, A B GAMMA in 2D; `a` along x, `b` in the
+    /// xy-plane
+    #[arg(long, num_args = 3..=6, value_names = ["A", "B", "C|GAMMA", "ALPHA", "BETA", "GAMMA"], value_parser = number, allow_negative_numbers = true)]
+    cellpar: Option<Vec<f64>>,
+}
+
+/// The extent of a 2D domain (`draw`).
+#[derive(Args)]
+#[group(required = true, multiple = false)]
+struct Extent2 {
+    /// Box lengths: the domain is [0,LX) × [0,LY)
+    #[arg(long = "box", num_args = 2, value_names = ["LX", "LY"], value_parser = number, allow_negative_numbers = true)]
+    box_lengths: Option<Vec<f64>>,
+    /// Lattice vectors (rows) AX AY BX BY; the domain is {f·M : f ∈ [0,1)²}
+    #[arg(long, num_args = 4, value_names = ["AX", "AY", "BX", "BY"], value_parser = number, allow_negative_numbers = true)]
+    lattice: Option<Vec<f64>>,
+    /// Cell lengths and angle in degrees: A B GAMMA (`a` along x, `b` at GAMMA from it)
+    #[arg(long, num_args = 3, value_names = ["A", "B", "GAMMA"], value_parser = number, allow_negative_numbers = true)]
+    cellpar: Option<Vec<f64>>,
+}
+
+impl From<Domain2> for Domain {
+    fn from(d: Domain2) -> Domain {
+        let Extent2 {
+            box_lengths,
+            lattice,
+            cellpar,
+        } = d.extent;
+        Domain {
+            space: d.space,
+            extent: Extent {
+                box_lengths,
+                lattice,
+                cellpar,
+            },
+        }
+    }
 }
 
 #[derive(Args)]
 struct Output {
-    /// Output file (default: standard output)
+    /// Output file (default: standard output); its extension, .cells or .txt, .json or
+    /// .vtu, picks the format, unless --format is given
     #[arg(short = 'o', long)]
     output: Option<PathBuf>,
-    /// Output format
-    #[arg(long, value_enum, default_value_t = Format::Cells)]
-    format: Format,
+    /// Output format (default: from the output's extension; cells on standard output)
+    #[arg(long, value_enum)]
+    format: Option<Format>,
     /// Print one line of key=value statistics to standard error
     #[arg(long)]
     stats: bool,
@@ -162,7 +234,7 @@ enum Format {
     /// JSON with lattice (manifold: space and group), wrapped points, first occurrences,
     /// cells and offsets (manifold: elements as isometries)
     Json,
-    /// VTK UnstructuredGrid (ParaView): one copy of each cell, drawn whole
+    /// VTK UnstructuredGrid (ParaView), binary: one copy of each cell, drawn whole
     Vtu,
 }
 
@@ -172,9 +244,13 @@ enum VoronoiFormat {
     Csv,
     /// The same columns as a float64 N×K array
     Npy,
+    /// The same columns as named arrays (`numpy.load(f)["volume"]`): id, volume,
+    /// neighbours, surface_area, centroid (N×D), duplicate_of (−1 for none)
+    Npz,
     /// Every cell: vertices, faces (vertex cycles, neighbour, shift, area), volume, centroid
     Json,
-    /// VTK UnstructuredGrid of the cells (polyhedra in 3D, polygons in 2D), drawn whole
+    /// VTK UnstructuredGrid of the cells (polyhedra in 3D, polygons in 2D), drawn whole,
+    /// binary, with id, volume, neighbours, surface_area and centroid as cell data
     Vtu,
 }
 
@@ -222,12 +298,35 @@ fn space(domain: &Domain) -> Result<Space, CliError> {
     }
 }
 
+/// `--box` with more than 3 numbers: what the user may have meant.
+fn box_usage(n: usize) -> CliError {
+    CliError::Usage(format!(
+        "--box takes the lengths LX LY [LZ], not {n} numbers: for lengths and angles (a b c α β γ) use --cellpar, for lattice vectors --lattice"
+    ))
+}
+
 fn torus(extent: &Extent) -> Result<Space, CliError> {
     if let Some(b) = &extent.box_lengths {
         return Ok(match b.len() {
             2 => Space::Torus2(FlatTorus2::cuboid([b[0], b[1]])?),
-            _ => Space::Torus3(FlatTorus3::cuboid([b[0], b[1], b[2]])?),
+            3 => Space::Torus3(FlatTorus3::cuboid([b[0], b[1], b[2]])?),
+            n => return Err(box_usage(n)),
         });
+    }
+    if let Some(c) = &extent.cellpar {
+        return match c.len() {
+            3 => {
+                let m = orbitri::io::lattice_from_cellpar2([c[0], c[1], c[2]])?;
+                Ok(Space::Torus2(FlatTorus2::triclinic(m)?))
+            }
+            6 => {
+                let m = orbitri::io::lattice_from_cellpar([c[0], c[1], c[2], c[3], c[4], c[5]])?;
+                Ok(Space::Torus3(FlatTorus3::triclinic(m)?))
+            }
+            n => Err(CliError::Usage(format!(
+                "--cellpar takes A B C ALPHA BETA GAMMA (3D) or A B GAMMA (2D), not {n} numbers"
+            ))),
+        };
     }
     let l = extent
         .lattice
@@ -253,8 +352,12 @@ fn torus(extent: &Extent) -> Result<Space, CliError> {
 fn manifold(name: &str, extent: &Extent) -> Result<Space, CliError> {
     let sides = if name == "klein" { "L1 L2" } else { "L1 L2 L3" };
     let Some(b) = &extent.box_lengths else {
+        let flag = match extent.lattice {
+            Some(_) => "--lattice",
+            None => "--cellpar",
+        };
         return Err(CliError::Usage(format!(
-            "--lattice is for the torus only: --space {name} takes --box {sides}"
+            "{flag} is for the torus only: --space {name} takes --box {sides}"
         )));
     };
     match (name, &b[..]) {
@@ -346,14 +449,58 @@ fn triangulate(input: PathBuf, domain: Domain, out: Output) -> Result<(), CliErr
     with_space!(space(&domain)?, triangulate_in(&input, out))
 }
 
+/// The format of an output: `--format` if given, else the one its extension names (its
+/// value name, or one of `aliases`), else `default` on standard output. An output whose
+/// extension names no format (or that has none) is an error naming those that do.
+fn output_format<F: ValueEnum + Copy>(
+    format: Option<F>,
+    output: &Option<PathBuf>,
+    aliases: &[(&str, F)],
+    default: F,
+) -> Result<F, CliError> {
+    let (Some(path), None) = (output, format) else {
+        return Ok(format.unwrap_or(default));
+    };
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    let known = ext.as_deref().and_then(|e| {
+        let alias = aliases.iter().find(|(a, _)| *a == e).map(|(_, f)| *f);
+        alias.or_else(|| F::from_str(e, true).ok())
+    });
+    known.ok_or_else(|| {
+        let names: Vec<String> = F::value_variants()
+            .iter()
+            .filter_map(|f| f.to_possible_value())
+            .map(|v| format!(".{}", v.get_name()))
+            .chain(aliases.iter().map(|(a, _)| format!(".{a}")))
+            .collect();
+        CliError::Usage(format!(
+            "{}: cannot tell the output format from {}: use {} or give --format",
+            path.display(),
+            ext.map_or("a name without extension".to_string(), |e| format!(
+                "the extension .{e}"
+            )),
+            names.join(", ")
+        ))
+    })
+}
+
 fn triangulate_in<const D: usize, const N: usize, S: SpaceFormat<D, N>>(
     space: S,
     input: &Path,
     out: Output,
 ) -> Result<(), CliError> {
+    let format = output_format(
+        out.format,
+        &out.output,
+        &[("txt", Format::Cells)],
+        Format::Cells,
+    )?;
     let pts: Vec<[f64; D]> = orbitri::io::read_points(input)?;
     let (tri, cost) = build(space, &pts)?;
-    write_with(&out.output, |w| match out.format {
+    write_with(&out.output, |w| match format {
         Format::Cells => orbitri::io::write_cells(w, &tri),
         Format::Json => orbitri::io::write_json(w, &tri),
         Format::Vtu => orbitri::io::write_delaunay_vtu(w, &tri),
@@ -395,13 +542,9 @@ fn voronoi_in<const D: usize, const N: usize, S: SpaceFormat<D, N>>(
     args: VoronoiArgs,
 ) -> Result<(), CliError> {
     space.check_volume_representable()?;
+    let format = output_format(args.format, &args.output, &[], VoronoiFormat::Csv)?;
     let pts: Vec<[f64; D]> = orbitri::io::read_points(input)?;
     let (tri, cost) = build(space, &pts)?;
-    let by_extension = args.output.as_ref().and_then(|p| {
-        let ext = p.extension()?.to_str()?.to_ascii_lowercase();
-        VoronoiFormat::from_str(&ext, true).ok()
-    });
-    let format = args.format.or(by_extension).unwrap_or(VoronoiFormat::Csv);
     // whole cells only when an output needs their geometry; tables need their measures
     let whole =
         matches!(format, VoronoiFormat::Json | VoronoiFormat::Vtu) || args.neighbours.is_some();
@@ -420,6 +563,7 @@ fn voronoi_in<const D: usize, const N: usize, S: SpaceFormat<D, N>>(
     write_with(&args.output, |w| match format {
         VoronoiFormat::Csv => orbitri::io::point_table(&tri, &measures).write_csv(w),
         VoronoiFormat::Npy => w.write_all(&orbitri::io::point_table(&tri, &measures).npy()),
+        VoronoiFormat::Npz => w.write_all(&orbitri::io::point_table(&tri, &measures).npz()?),
         VoronoiFormat::Json => orbitri::io::write_voronoi_json(w, &tri, &cells),
         VoronoiFormat::Vtu => orbitri::io::write_voronoi_vtu(w, &cells),
     })?;
@@ -444,11 +588,19 @@ fn voronoi_in<const D: usize, const N: usize, S: SpaceFormat<D, N>>(
 }
 
 fn draw(input: PathBuf, domain: Domain, output: PathBuf, opts: SvgOptions) -> Result<(), CliError> {
+    let ext = output.extension().and_then(|e| e.to_str());
+    if !ext.is_some_and(|e| e.eq_ignore_ascii_case("svg") || e.eq_ignore_ascii_case("png")) {
+        return Err(CliError::Usage(format!(
+            "{}: draw writes .svg or .png pictures, not {}",
+            output.display(),
+            ext.map_or("a name without extension".to_string(), |e| format!(".{e}"))
+        )));
+    }
     match space(&domain)? {
         Space::Torus2(s) => draw_in(s, &input, output, opts),
         Space::Klein(s) => draw_in(s, &input, output, opts),
         _ => Err(CliError::Usage(
-            "draw renders 2D spaces: give --box LX LY or --lattice AX AY BX BY (or --space klein --box L1 L2)".into(),
+            "draw renders 2D spaces: give --box LX LY, --lattice AX AY BX BY or --cellpar A B GAMMA (or --space klein --box L1 L2)".into(),
         )),
     }
 }
@@ -662,7 +814,7 @@ fn mark_negative_numbers(args: impl IntoIterator<Item = OsString>) -> Vec<OsStri
     let mut args = args.into_iter().peekable();
     while let Some(arg) = args.next() {
         let most = match arg.to_str() {
-            Some("--box") => 3,
+            Some("--box") | Some("--cellpar") => 6,
             Some("--lattice") => 9,
             Some("--") => {
                 out.push(arg);
@@ -728,7 +880,7 @@ fn main() -> ExitCode {
             no_delaunay,
         } => draw(
             input,
-            domain,
+            domain.into(),
             output,
             SvgOptions {
                 copies,

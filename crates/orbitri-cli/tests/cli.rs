@@ -324,7 +324,12 @@ fn numbers_are_read_as_rust_reads_them() {
         (&p2, "--lattice 1 0 0 1 -2e-1", "takes 4 numbers"),
         (&p2, "--lattice 1 -2e-1 0", "4 values required"),
         (&p2, "--box 1", "2 values required"),
-        (&p3, "--box 1 1 1 -5", "unexpected argument '-5'"),
+        (
+            &p3,
+            "--box 1 1 1 -5",
+            "--box takes the lengths LX LY [LZ], not 4 numbers",
+        ),
+        (&p3, "--box 1 1 1 1 1 1 -5", "unexpected argument '-5'"),
         (&p2, "--box 1 x", "invalid value 'x'"),
     ] {
         let o = run(input, domain);
@@ -503,8 +508,13 @@ fn draw_writes_svg_and_png() {
         "-o",
         "x.svg",
     ]);
+    // draw's --box takes 2 lengths: its usage says so
     assert_eq!(o.status.code(), Some(2));
-    assert!(stderr(&o).contains("2D"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("unexpected argument '1'") && stderr(&o).contains("--box <LX> <LY>|"),
+        "{}",
+        stderr(&o)
+    );
 }
 
 #[test]
@@ -594,7 +604,8 @@ fn voronoi_tables_cells_and_vtk() {
         }
         let o = orbitri(&args);
         assert!(o.status.success(), "{}", stderr(&o));
-        let text = std::fs::read_to_string(&out).unwrap();
+        // a binary VTU's XML header is text; its appended data is not
+        let text = String::from_utf8_lossy(&std::fs::read(&out).unwrap()).into_owned();
         if name.ends_with("json") {
             assert!(text.starts_with("{\"dimension\":3"));
             assert_eq!(text.matches("\"neighbor\"").count(), faces);
@@ -602,12 +613,17 @@ fn voronoi_tables_cells_and_vtk() {
             assert!(text.contains("<VTKFile type=\"UnstructuredGrid\""));
             assert!(text.contains("NumberOfCells=\"300\""));
             assert!(text.contains("Name=\"faceoffsets\""));
+            assert!(text.contains("compressor=\"vtkZLibDataCompressor\""));
+            assert!(text.contains("<AppendedData encoding=\"raw\">"));
+            for name in ["neighbours", "surface_area", "centroid"] {
+                assert!(text.contains(&format!("Name=\"{name}\"")), "{name}");
+            }
         }
     }
     let vtu = dir.path().join("t.vtu");
     let o = triangulate_cube(&input, &["--format", "vtu", "-o", vtu.to_str().unwrap()]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let text = std::fs::read_to_string(&vtu).unwrap();
+    let text = String::from_utf8_lossy(&std::fs::read(&vtu).unwrap()).into_owned();
     assert!(text.contains(&format!("NumberOfCells=\"{cells}\"")));
     let pts2 = dir.path().join("p2.txt");
     orbitri(&["generate", "50", "--dim", "2", "-o", pts2.to_str().unwrap()]);
@@ -921,8 +937,7 @@ fn manifold_voronoi_faces_and_tables_carry_elements() {
         &["--format", "vtu", "-o", vtu.to_str().unwrap()],
     );
     assert!(o.status.success(), "{}", stderr(&o));
-    assert!(std::fs::read_to_string(&vtu)
-        .unwrap()
+    assert!(String::from_utf8_lossy(&std::fs::read(&vtu).unwrap())
         .contains("<VTKFile type=\"UnstructuredGrid\""));
 }
 
@@ -1027,7 +1042,7 @@ fn draw_shows_the_klein_bottle_with_its_glide_images() {
     // a flag per image: 9 images, 2 strokes each
     let glides = text.lines().find(|l| l.contains("id=\"glides\"")).unwrap();
     assert_eq!(glides.matches('M').count(), 18);
-    // the 3D manifolds have no pictures
+    // the 3D manifolds have no pictures: draw does not offer them
     let p3 = generated(dir.path(), 10, 3, 1);
     let o = in_space(
         "draw",
@@ -1037,5 +1052,103 @@ fn draw_shows_the_klein_bottle_with_its_glide_images() {
         &["-o", svg.to_str().unwrap()],
     );
     assert_eq!(o.status.code(), Some(2));
-    assert!(stderr(&o).contains("2D"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("[possible values: torus, klein]"),
+        "{}",
+        stderr(&o)
+    );
+}
+
+/// Runs the command with the blank-separated words of `line` (paths without blanks).
+fn run_line(line: &str) -> std::process::Output {
+    orbitri(&line.split_whitespace().collect::<Vec<_>>())
+}
+
+#[test]
+fn output_formats_come_from_known_extensions_only() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = generated(dir.path(), 40, 2, 3);
+    let input = input.to_str().unwrap();
+    let d = dir.path().to_str().unwrap();
+    for (command, name, message) in [
+        ("voronoi", "v.txt", "v.txt: cannot tell the output format from the extension .txt: use .csv, .npy, .npz, .json, .vtu or give --format"),
+        ("voronoi", "v", "cannot tell the output format from a name without extension"),
+        ("triangulate", "t.out", "use .cells, .json, .vtu, .txt or give --format"),
+        ("draw", "d.jpg", "d.jpg: draw writes .svg or .png pictures, not .jpg"),
+    ] {
+        let o = run_line(&format!("{command} {input} --box 1 1 -o {d}/{name}"));
+        assert_eq!(o.status.code(), Some(2), "{command} {name}");
+        assert!(stderr(&o).contains(message), "{}", stderr(&o));
+        assert!(!dir.path().join(name).exists(), "{name} was written");
+    }
+    // --format names it whatever the extension; .txt is the cells format
+    for line in [
+        format!("voronoi {input} --box 1 1 -o {d}/v.txt --format csv"),
+        format!("triangulate {input} --box 1 1 -o {d}/t.txt"),
+        format!("voronoi {input} --box 1 1 -o {d}/v.npz"),
+    ] {
+        let o = run_line(&line);
+        assert!(o.status.success(), "{line}: {}", stderr(&o));
+    }
+    let cells = std::fs::read_to_string(dir.path().join("t.txt")).unwrap();
+    assert!(cells.starts_with("1 40 80\n"), "{cells}");
+    // .npz: named arrays in a zip archive
+    let z = std::fs::read(dir.path().join("v.npz")).unwrap();
+    assert_eq!(&z[..4], b"PK\x03\x04");
+    let text = String::from_utf8_lossy(&z);
+    for name in "id volume neighbours surface_area centroid duplicate_of".split(' ') {
+        assert!(text.contains(&format!("{name}.npy")), "{name}");
+    }
+}
+
+#[test]
+fn cellpar_gives_lengths_and_angles() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = generated(dir.path(), 300, 3, 4);
+    let input = input.to_str().unwrap();
+    // a hexagonal prism cell: a = b = 1, c = 2, γ = 120°; the volumes sum to its volume
+    let o = run_line(&format!(
+        "voronoi {input} --cellpar 1 1 2 90 90 120 --stats"
+    ));
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    let domain = err.split("domain_volume=").nth(1).unwrap();
+    let domain: f64 = domain.split(' ').next().unwrap().parse().unwrap();
+    assert!((domain - 3f64.sqrt()).abs() < 1e-12, "{err}");
+    // 2D: A B GAMMA, for draw too
+    let input2 = generated(dir.path(), 30, 2, 5);
+    let svg = dir.path().join("h.svg");
+    let o = run_line(&format!(
+        "draw {} --cellpar 1 1 60 -o {}",
+        input2.display(),
+        svg.display()
+    ));
+    assert!(o.status.success(), "{}", stderr(&o));
+    for (domain, message) in [
+        // six numbers after --box are lengths and angles given to the wrong flag
+        ("--box 10 10 10 90 90 90", "--box takes the lengths LX LY [LZ], not 6 numbers: for lengths and angles (a b c α β γ) use --cellpar"),
+        ("--cellpar 1 1 1 120 120 120", "make no cell"),
+        ("--space dicosm --cellpar 1 1 1 90 90 90", "--cellpar is for the torus only: --space dicosm takes --box L1 L2 L3"),
+    ] {
+        let o = run_line(&format!("voronoi {input} {domain}"));
+        assert_eq!(o.status.code(), Some(2), "{domain}");
+        assert!(stderr(&o).contains(message), "{}", stderr(&o));
+    }
+}
+
+#[test]
+fn draw_help_is_two_dimensional_and_generate_is_documented() {
+    let o = orbitri(&["draw", "--help"]);
+    let help = String::from_utf8_lossy(&o.stdout).into_owned();
+    assert!(
+        help.contains("--box <LX> <LY>\n") || help.contains("--box <LX> <LY>|"),
+        "{help}"
+    );
+    assert!(!help.contains("LZ") && !help.contains("AZ"), "{help}");
+    assert!(!help.contains("dicosm"), "{help}");
+    let o = orbitri(&["generate", "--help"]);
+    let help = String::from_utf8_lossy(&o.stdout).into_owned();
+    for doc in ["How many points", "Seed of the generator", "Output file"] {
+        assert!(help.contains(doc), "{doc}: {help}");
+    }
 }

@@ -1140,9 +1140,31 @@ impl Space {
     }
 }
 
+/// The lattice vectors (rows) of a cell given by lengths and angles in degrees: `[a, b, c,
+/// alpha, beta, gamma]` (3 × 3) or `[a, b, gamma]` (2 × 2); a ValueError for a cell that
+/// does not exist.
+#[pyfunction]
+fn cellpar_matrix<'py>(py: Python<'py>, p: Vec<f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    match p[..] {
+        [a, b, c, alpha, beta, gamma] => {
+            let m = orbitri::io::lattice_from_cellpar([a, b, c, alpha, beta, gamma]);
+            Ok(array2(py, 3, 3, m.map_err(value_error)?.as_flattened().to_vec()))
+        }
+        [a, b, gamma] => {
+            let m = orbitri::io::lattice_from_cellpar2([a, b, gamma]);
+            Ok(array2(py, 2, 2, m.map_err(value_error)?.as_flattened().to_vec()))
+        }
+        _ => Err(PyValueError::new_err(format!(
+            "lengths and angles are [a, b, c, alpha, beta, gamma] (3D) or [a, b, gamma] (2D), not {} numbers",
+            p.len()
+        ))),
+    }
+}
+
 #[pymodule]
 fn _orbitri(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add_function(wrap_pyfunction!(cellpar_matrix, m)?)?;
     m.add_class::<Triangulation>()?;
     m.add_class::<Voronoi>()?;
     m.add_class::<Space>()?;

@@ -31,10 +31,40 @@ fn config(default_cases: u32, seed: u64) -> ProptestConfig {
 const TXT: &str = "fuzz.txt";
 const NPY: &str = "fuzz.npy";
 
+/// The header of `body`, if the line is one (no field a number, none empty but the first):
+/// its number of fields and the fields of the `d` coordinates, `None` inside for a header
+/// the reader must reject.
+fn header(body: &str, d: usize) -> Option<Option<(usize, Vec<usize>)>> {
+    let fields: Vec<&str> = if body.contains(',') {
+        body.split(',').map(str::trim).collect()
+    } else {
+        body.split_whitespace().collect()
+    };
+    let numbers = fields.iter().any(|f| f.parse::<f64>().is_ok());
+    if numbers || fields[1..].iter().any(|f| f.is_empty()) {
+        return None;
+    }
+    let n = fields.len();
+    let named: Option<Vec<usize>> = ["x", "y", "z"][..d]
+        .iter()
+        .map(|a| fields.iter().position(|f| f.eq_ignore_ascii_case(a)))
+        .collect();
+    Some(match named {
+        Some(at) => Some((n, at)),
+        None if n == d + 1 && fields[0].is_empty() => Some((n, (1..=d).collect())),
+        None if n == d => Some((n, (0..d).collect())),
+        None => None,
+    })
+}
+
 /// What the text format says, read independently of the reader: the rows of numbers of the
-/// data lines (not blank, not comment), `None` for a line the reader must reject.
-fn text_rows(bytes: &[u8]) -> Vec<Option<Vec<f64>>> {
+/// data lines (not blank, not comment), `None` for a line the reader must reject. The first
+/// line with values may be a header (skipped, see [`header`]); after one, a row has its
+/// number of fields and the named ones are the coordinates.
+fn text_rows(bytes: &[u8], d: usize) -> Vec<Option<Vec<f64>>> {
     let mut rows = Vec::new();
+    let mut columns: Option<(usize, Vec<usize>)> = None;
+    let mut first = true;
     for (k, line) in bytes.split(|&b| b == b'\n').enumerate() {
         let Ok(mut line) = std::str::from_utf8(line) else {
             rows.push(None);
@@ -51,6 +81,20 @@ fn text_rows(bytes: &[u8]) -> Vec<Option<Vec<f64>>> {
             continue;
         }
         let body = line.split('#').next().unwrap();
+        if first && !body.trim().is_empty() {
+            first = false;
+            match header(body, d) {
+                Some(Some(h)) => {
+                    columns = Some(h);
+                    continue;
+                }
+                Some(None) => {
+                    rows.push(None);
+                    continue;
+                }
+                None => {}
+            }
+        }
         if body.contains(',') && body.split(',').any(|f| f.trim().is_empty()) {
             rows.push(None);
             continue;
@@ -62,8 +106,16 @@ fn text_rows(bytes: &[u8]) -> Vec<Option<Vec<f64>>> {
         if values.is_empty() {
             continue;
         }
-        let numbers: Vec<f64> = values.iter().filter_map(|v| v.parse().ok()).collect();
-        rows.push((numbers.len() == values.len()).then_some(numbers));
+        rows.push(match &columns {
+            None => {
+                let numbers: Vec<f64> = values.iter().filter_map(|v| v.parse().ok()).collect();
+                (numbers.len() == values.len()).then_some(numbers)
+            }
+            Some((n, at)) if values.len() == *n => {
+                at.iter().map(|&c| values[c].parse().ok()).collect()
+            }
+            Some(_) => None,
+        });
     }
     rows
 }
@@ -100,7 +152,7 @@ fn check_text<const D: usize>(bytes: &[u8]) -> Result<(), TestCaseError> {
     let lines = bytes.split(|&b| b == b'\n').count();
     match parse_text::<D>(bytes, Path::new(TXT)) {
         Ok(points) => {
-            let rows = text_rows(bytes);
+            let rows = text_rows(bytes, D);
             prop_assert_eq!(rows.len(), points.len());
             for (row, p) in rows.iter().zip(&points) {
                 let row = row.as_ref().expect("a line the reader must reject");

@@ -2,6 +2,13 @@
 //! comment, blank lines are skipped. A UTF-8 byte-order mark at the start of the file is
 //! skipped; an empty field between commas and a control character (other than tab, CR and
 //! LF) are errors.
+//!
+//! The first line with values may be a header, a line none of whose fields is a number (as
+//! pandas' `to_csv` writes): it is skipped. If it names columns `x`, `y` (and `z`), those
+//! are read, in that order, from rows of as many fields as the header has (the other fields
+//! may hold anything but an empty field or a comma); if its first
+//! field is empty (pandas' unnamed index) and it has `D + 1` fields, the first column is
+//! left out; otherwise it must have `D` fields.
 
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
@@ -43,6 +50,9 @@ fn parse_lines<const D: usize>(mut input: impl BufRead, file: &Path) -> Result<V
     let mut out = Vec::new();
     let mut buf = Vec::new();
     let mut line = 0;
+    // after a header: the header's number of fields, and the field read as each coordinate
+    let mut columns: Option<(usize, [usize; D])> = None;
+    let mut first_values = true;
     loop {
         buf.clear();
         let n = input
@@ -94,6 +104,13 @@ fn parse_lines<const D: usize>(mut input: impl BufRead, file: &Path) -> Result<V
         }
         let body = raw.split('#').next().unwrap_or("");
         let commas = body.contains(',');
+        if first_values && !body.trim().is_empty() {
+            first_values = false;
+            if let Some(header) = header_columns::<D>(body).map_err(|m| err(line, m))? {
+                columns = Some(header);
+                continue;
+            }
+        }
         let mut p = [0.0; D];
         let mut count = 0;
         for (field, text) in body.split(',').enumerate() {
@@ -106,20 +123,24 @@ fn parse_lines<const D: usize>(mut input: impl BufRead, file: &Path) -> Result<V
                 ));
             }
             for f in first.into_iter().chain(values) {
-                if count < D {
+                let axis = match &columns {
+                    None => (count < D).then_some(count),
+                    Some((_, at)) => at.iter().position(|&c| c == count),
+                };
+                if let Some(axis) = axis {
                     let v: f64 = f.parse().map_err(|_| {
                         err(
                             line,
-                            format!("coordinate {count} '{}' is not a number", clip(f)),
+                            format!("coordinate {axis} '{}' is not a number", clip(f)),
                         )
                     })?;
                     if !v.is_finite() {
                         return Err(err(
                             line,
-                            format!("coordinate {count} is {v}, not a finite number"),
+                            format!("coordinate {axis} is {v}, not a finite number"),
                         ));
                     }
-                    p[count] = v;
+                    p[axis] = v;
                 }
                 count += 1;
             }
@@ -127,11 +148,16 @@ fn parse_lines<const D: usize>(mut input: impl BufRead, file: &Path) -> Result<V
         if count == 0 {
             continue;
         }
-        if count != D {
+        let fields = columns.map_or(D, |(n, _)| n);
+        if count != fields {
+            let what = match columns {
+                None => "coordinates",
+                Some(_) => "fields (as the header has)",
+            };
             return Err(err(
                 line,
                 format!(
-                    "expected {D} coordinates, found {count} ({:?})",
+                    "expected {fields} {what}, found {count} ({:?})",
                     clip(body.trim())
                 ),
             ));
@@ -142,6 +168,40 @@ fn parse_lines<const D: usize>(mut input: impl BufRead, file: &Path) -> Result<V
         return Err(err(line.max(1), "the file holds no points".into()));
     }
     Ok(out)
+}
+
+/// If `body` is a header (no field is a number), the number of its fields and the field of
+/// each coordinate; an error if it is a header this reader cannot use.
+fn header_columns<const D: usize>(
+    body: &str,
+) -> std::result::Result<Option<(usize, [usize; D])>, String> {
+    let fields: Vec<&str> = if body.contains(',') {
+        body.split(',').map(str::trim).collect()
+    } else {
+        body.split_whitespace().collect()
+    };
+    // names: none a number, only the first (pandas' index) may be empty
+    if fields.iter().any(|f| f.parse::<f64>().is_ok()) || fields[1..].iter().any(|f| f.is_empty()) {
+        return Ok(None);
+    }
+    let n = fields.len();
+    let named: Option<Vec<usize>> = ["x", "y", "z"][..D]
+        .iter()
+        .map(|a| fields.iter().position(|f| f.eq_ignore_ascii_case(a)))
+        .collect();
+    let at: Vec<usize> = match named {
+        Some(at) => at,
+        None if n == D + 1 && fields[0].is_empty() => (1..=D).collect(),
+        None if n == D => (0..D).collect(),
+        None => {
+            return Err(format!(
+                "a header of {n} columns ({:?}) that names no columns x, y{}: expected {D} columns, or one more with an empty first name (pandas' index)",
+                clip(body.trim()),
+                if D == 3 { ", z" } else { "" }
+            ))
+        }
+    };
+    Ok(Some((n, std::array::from_fn(|k| at[k]))))
 }
 
 #[cfg(test)]
@@ -202,6 +262,44 @@ mod tests {
         // blanks around commas, blanks only, and commas mixed with blanks stay fine
         let p = parse("0.1 , 0.2 ,\t0.3\n0.4 0.5 0.6\n0.7, 0.8 0.9\n").unwrap();
         assert_eq!(p, vec![[0.1, 0.2, 0.3], [0.4, 0.5, 0.6], [0.7, 0.8, 0.9]]);
+    }
+
+    #[test]
+    fn a_header_line_is_skipped() {
+        // pandas' to_csv(index=False), and blank-separated names
+        let p = parse("x,y,z\n0.1,0.2,0.3\n0.4,0.5,0.6\n").unwrap();
+        assert_eq!(p, vec![[0.1, 0.2, 0.3], [0.4, 0.5, 0.6]]);
+        assert_eq!(
+            parse("# c\n\na b c\n0.1 0.2 0.3\n").unwrap(),
+            vec![[0.1, 0.2, 0.3]]
+        );
+        // pandas' to_csv() with its unnamed index: the first column is left out
+        let p = parse(",x,y,z\n0,0.1,0.2,0.3\n1,0.4,0.5,0.6\n").unwrap();
+        assert_eq!(p, vec![[0.1, 0.2, 0.3], [0.4, 0.5, 0.6]]);
+        // named columns anywhere, in any order
+        let p = parse("id,z,type,x,y\n7,0.3,1,0.1,0.2\n").unwrap();
+        assert_eq!(p, vec![[0.1, 0.2, 0.3]]);
+        // the other columns may hold names (an element), not only numbers
+        let p = parse("id,type,x,y,z\n1,Cu,0.1,0.2,0.3\n").unwrap();
+        assert_eq!(p, vec![[0.1, 0.2, 0.3]]);
+        // empty names are no header (but pandas' unnamed index)
+        assert!(error(",,\n0.1,0.2,0.3\n").starts_with("in.txt:1: field 1 is empty"));
+        let p = parse_text::<2>("X Y\n0.1 0.2\n", Path::new("in.txt")).unwrap();
+        assert_eq!(p, vec![[0.1, 0.2]]);
+        // rows must have the header's fields; only the first line may be a header
+        assert!(error("id,x,y,z\n0.1,0.2,0.3\n")
+            .starts_with("in.txt:2: expected 4 fields (as the header has), found 3"));
+        assert_eq!(
+            error("0.1,0.2,0.3\nx,y,z\n"),
+            "in.txt:2: coordinate 0 'x' is not a number"
+        );
+        let e = error("a,b\n0.1,0.2,0.3\n");
+        assert!(
+            e.starts_with(
+                "in.txt:1: a header of 2 columns (\"a,b\") that names no columns x, y, z"
+            ),
+            "{e}"
+        );
     }
 
     #[test]
