@@ -3,7 +3,9 @@
 # with the CGAL anchor (../shared/anchors/cgal, built by bench/run.sh's recipe if missing):
 # per N and repetition, orbitri's removal of input points 0, 2, 4, … (one `remove` each,
 # and one `remove_all`), then CGAL's `dt3rm` and `p3dt3rm` on the same points; then the
-# moving loop (10 steps of moves by 1% of the spacing against rebuilding each step).
+# moving loop (10 steps of moves by 1% of the spacing against rebuilding each step); then
+# insertion one at a time in random order, insert_all and find_simplex against the bulk
+# build (examples/batch.rs).
 #
 # usage: bench/dynamic.sh [REPS] [N ...]      default: 3 reps, N = 100000 1000000
 set -euo pipefail
@@ -12,7 +14,7 @@ anchor_src=${ANCHOR:-$root/../shared/anchors/cgal}
 out=$root/bench/out
 mkdir -p "$out"
 . "$root/bench/anchor.sh"
-cargo build --release -q -p orbitri --example dynamic --manifest-path "$root/Cargo.toml"
+cargo build --release -q -p orbitri --example dynamic --example batch --manifest-path "$root/Cargo.toml"
 dyn=$root/target/release/examples/dynamic
 cgal=$out/cgal/cgal_anchor
 reps=${1:-3}
@@ -27,3 +29,4 @@ for n in $ns; do
     done
 done | tee -a "$out/dynamic_raw.txt"
 "$dyn" move "$reps" 100000 | tee -a "$out/dynamic_raw.txt"
+"$root/target/release/examples/batch" "$reps" $ns | tee -a "$out/dynamic_raw.txt"
