@@ -372,15 +372,17 @@ fn manifold(name: &str, extent: &Extent) -> Result<Space, CliError> {
     }
 }
 
-fn progress_bar(n: usize) -> Option<ProgressBar> {
-    if n < 200_000 || !std::io::stderr().is_terminal() {
+/// A progress bar on a terminal for the phase `what` of `points` points (none for small
+/// inputs), `len` steps long.
+fn progress_bar(points: usize, len: usize, what: &str) -> Option<ProgressBar> {
+    if points < 200_000 || !std::io::stderr().is_terminal() {
         return None;
     }
-    let bar = ProgressBar::new(n as u64);
+    let bar = ProgressBar::new(len as u64);
     bar.set_style(
-        ProgressStyle::with_template(
-            "{elapsed_precise} [{bar:40}] {pos}/{len} points ({eta} left)",
-        )
+        ProgressStyle::with_template(&format!(
+            "{{elapsed_precise}} {what} [{{bar:40}}] {{percent}}% ({{eta}} left)"
+        ))
         .unwrap(),
     );
     Some(bar)
@@ -397,7 +399,7 @@ fn build<const D: usize, const N: usize, S: FlatSpace<D, N>>(
     space: S,
     pts: &[[f64; D]],
 ) -> Result<(Triangulation<D, N, S>, Cost), orbitri::Error> {
-    let bar = progress_bar(pts.len());
+    let bar = progress_bar(pts.len(), pts.len(), "triangulation");
     let start = Instant::now();
     let tri = Triangulation::build_with(space, pts, BuildOptions::default(), |k| {
         if let Some(b) = &bar {
@@ -549,16 +551,29 @@ fn voronoi_in<const D: usize, const N: usize, S: SpaceFormat<D, N>>(
     let whole =
         matches!(format, VoronoiFormat::Json | VoronoiFormat::Vtu) || args.neighbours.is_some();
     let start = Instant::now();
+    // the Voronoi phase reports every 1024 triangulation cells (circumcenters), then every
+    // 1024 points (their cells)
+    let n = tri.number_of_vertices();
+    let bar = progress_bar(n, tri.engine().cell_slots() + n, "Voronoi cells");
+    let tick = || {
+        if let Some(b) = &bar {
+            b.inc(1024);
+        }
+        false
+    };
     let cells = if whole {
-        tri.voronoi_cells()
+        tri.voronoi_cells_until(&tick)?
     } else {
         Vec::new()
     };
     let measures: Vec<orbitri::CellMeasures<D>> = if whole {
         cells.iter().map(orbitri::CellMeasures::from).collect()
     } else {
-        tri.voronoi_measures()
+        tri.voronoi_measures_until(&tick)?
     };
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
     let seconds = start.elapsed().as_secs_f64();
     write_with(&args.output, |w| match format {
         VoronoiFormat::Csv => orbitri::io::point_table(&tri, &measures).write_csv(w),
