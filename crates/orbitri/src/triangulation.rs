@@ -164,6 +164,18 @@ fn spatial_order<const D: usize, const N: usize, S: FlatSpace<D, N>>(
     crate::sort::brio_order(&keys, seed)
 }
 
+/// The indices of internal points in Hilbert order (a batch of moves or queries: each
+/// next one near the previous).
+fn hilbert_order<const D: usize, const N: usize, S: FlatSpace<D, N>>(
+    space: &S,
+    points: &[[f64; D]],
+) -> Vec<u32> {
+    let keys: Vec<u64> = points.par_iter().map(|p| space.spatial_key(p)).collect();
+    let mut order: Vec<u32> = (0..points.len() as u32).collect();
+    order.par_sort_unstable_by_key(|&k| keys[k as usize]);
+    order
+}
+
 /// Reports progress `k` to the build's callback: `Err(Interrupted)` if it asks to stop.
 fn proceed(progress: &mut impl FnMut(usize) -> ControlFlow<()>, k: usize) -> Result<()> {
     match progress(k) {
@@ -510,9 +522,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
                 Moved::Duplicate(q) => {
                     self.forget_point(p);
                     self.record_duplicate(i, q);
-                    if self.point_input[q.index()] == i {
-                        self.represent(q, w);
-                    }
+                    self.represent_if_first(q, i, w);
                     return false;
                 }
                 Moved::Refused => {}
@@ -520,11 +530,17 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         }
         self.remove(i).expect("a live input");
         if let Inserted::Duplicate(q) = self.insert_wrapped(i, w) {
-            if self.point_input[q.index()] == i {
-                self.represent(q, w);
-            }
+            self.represent_if_first(q, i, w);
         }
         false
+    }
+
+    /// Input `i`, moved to `w`, became a duplicate of point `q`: when `i` is now `q`'s
+    /// first occurrence, `q` takes `i`'s coordinates.
+    fn represent_if_first(&mut self, q: PointId, i: InputId, w: [f64; D]) {
+        if self.point_input[q.index()] == i {
+            self.represent(q, w);
+        }
     }
 
     /// True when input id `i` was given and not removed.
@@ -552,14 +568,9 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             .zip(to)
             .map(|(&i, p)| Ok(internal_point(self.space(), i.index(), p)?.0))
             .collect::<Result<Vec<_>>>()?;
-        let keys: Vec<u64> = targets
-            .iter()
-            .map(|p| self.space().spatial_key(p))
-            .collect();
-        let mut order: Vec<usize> = (0..ids.len()).collect();
-        order.sort_unstable_by_key(|&k| keys[k]);
         let mut fast = vec![false; ids.len()];
-        for k in order {
+        for k in hilbert_order(self.space(), &targets) {
+            let k = k as usize;
             fast[k] = self.move_internal(ids[k], targets[k]);
         }
         Ok(fast)
@@ -926,14 +937,8 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         for (k, c) in self.engine.cell_ids().enumerate() {
             row[c.index()] = k;
         }
-        let keys: Vec<u64> = internal
-            .par_iter()
-            .map(|p| self.space().spatial_key(p))
-            .collect();
-        let mut order: Vec<u32> = (0..points.len() as u32).collect();
-        order.par_sort_unstable_by_key(|&k| keys[k as usize]);
         let (internal, row) = (&internal, &row);
-        let found: Vec<(u32, usize)> = order
+        let found: Vec<(u32, usize)> = hilbert_order(self.space(), internal)
             .par_chunks(4096)
             .flat_map_iter(|chunk| {
                 let mut from = None;

@@ -221,7 +221,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// ([`PointId::NONE`] for the dropped ones).
     pub(crate) fn compact(&mut self, gone: &[bool]) -> Vec<PointId> {
         let map = renumbering(gone);
-        let sheets = self.copies.len().max(1) as u32;
+        let sheets = self.space.sheets(self.level) as u32;
         let vertex_gone: Vec<bool> = gone
             .iter()
             .flat_map(|&g| std::iter::repeat_n(g, sheets as usize))

@@ -62,10 +62,10 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// jump-and-walk grid) or else from the last insertion; it only reads the
     /// triangulation, so queries may run in parallel.
     pub fn locate(&self, p: S::Point) -> (CellId, S::Elem) {
-        let (start, shift) = self
+        let from = self
             .jump(self.space.spatial_key(&p))
             .unwrap_or_else(|| self.start_cell());
-        self.walk((p, shift), start, &mut SplitMix::new(0x10ca7e))
+        self.locate_from_cell(p, from)
     }
 
     /// The cell containing the point (at the identity), walking from `from`, a cell near

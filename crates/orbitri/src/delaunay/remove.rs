@@ -77,17 +77,17 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// whether the remaining points had to be triangulated again.
     pub fn remove_points(&mut self, ps: &[PointId]) -> (Vec<PointId>, bool) {
         let n = self.points.len();
+        if ps.len() == n {
+            self.clear();
+            return (vec![PointId::NONE; n], false);
+        }
         let mut gone = vec![false; n];
         let mut rebuild = false;
         for &p in ps {
             gone[p.index()] = true;
-            if ps.len() < n && !rebuild && !self.remove_copies(p) {
+            if !rebuild && !self.remove_copies(p) {
                 rebuild = true;
             }
-        }
-        if ps.len() == n {
-            self.clear();
-            return (vec![PointId::NONE; n], false);
         }
         if !rebuild {
             return (self.compact(&gone), false);
@@ -105,9 +105,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// triangulation is left unchanged (1-sheeted) or half done (a covering): the caller
     /// triangulates the remaining points again.
     fn remove_copies(&mut self, p: PointId) -> bool {
-        if self.one_sheeted {
-            return self.remove_vertex(self.vertex_of_point(p)).is_ok();
-        }
+        // (the quotient has one sheet: its vertex is the point's id)
         let sheets = self.space.sheets(self.level) as u32;
         (0..sheets).all(|s| self.remove_vertex(VertexId(p.0 * sheets + s)).is_ok())
     }
@@ -116,11 +114,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// each of its vertices (one per sheet) renamed in the cells around it.
     fn renumber_last_point(&mut self, p: PointId) {
         let last = self.points.len() - 1;
-        let sheets = if self.one_sheeted {
-            1
-        } else {
-            self.space.sheets(self.level)
-        };
+        let sheets = self.space.sheets(self.level);
         if p.index() != last {
             for k in 0..sheets {
                 let from = VertexId::new(last * sheets + k);
