@@ -44,6 +44,28 @@ impl Scaled {
         Scaled { emin }
     }
 
+    /// The common scale of lengths `values` and squared lengths `squares` (weights, all
+    /// finite): the lengths are integers at `2^emin`, the squares at `2^(2·emin)`.
+    pub fn with_squares(
+        values: impl IntoIterator<Item = f64>,
+        squares: impl IntoIterator<Item = f64>,
+    ) -> Scaled {
+        let e = Scaled::new(values).emin;
+        let half = squares
+            .into_iter()
+            .filter(|v| *v != 0.0)
+            .map(|v| decompose(v).1.div_euclid(2))
+            .min()
+            .unwrap_or(e);
+        Scaled { emin: e.min(half) }
+    }
+
+    /// `x / 2^(2·emin)` as an exact integer (a squared length, see [`Self::with_squares`]).
+    pub fn int2(&self, x: f64) -> BigInt {
+        let (m, e) = decompose(x);
+        BigInt::from(m) << ((e - 2 * self.emin) as usize)
+    }
+
     /// The common scale: the integers are the values divided by `2^exponent`.
     pub fn exponent(&self) -> i32 {
         self.emin
@@ -93,6 +115,16 @@ pub fn ratio_to_f64(num: &BigInt, den: &BigInt, exp: i32) -> f64 {
     }
 }
 
+/// The determinant of `D` rows of `D` big integers (`D` 2 or 3).
+pub fn det<const D: usize>(rows: [&[BigInt; D]; D]) -> BigInt {
+    if D == 2 {
+        &rows[0][0] * &rows[1][1] - &rows[0][1] * &rows[1][0]
+    } else {
+        let r = |i: usize| -> [BigInt; 3] { std::array::from_fn(|c| rows[i][c].clone()) };
+        det3(&r(0), &r(1), &r(2))
+    }
+}
+
 /// `det [a; b; c]` of three rows.
 pub fn det3(a: &[BigInt; 3], b: &[BigInt; 3], c: &[BigInt; 3]) -> BigInt {
     &a[0] * (&b[1] * &c[2] - &b[2] * &c[1]) - &a[1] * (&b[0] * &c[2] - &b[2] * &c[0])
@@ -132,11 +164,29 @@ mod tests {
     }
 
     #[test]
+    fn squares_share_the_scale() {
+        // 0.75 = 3·2^-2 and a weight 2^-7: lengths at 2^-4, squares at 2^-8
+        let s = Scaled::with_squares([0.75, 1.0], [2f64.powi(-7), 4.0]);
+        assert_eq!(s.exponent(), -4);
+        assert_eq!(s.int(0.75), BigInt::from(12));
+        assert_eq!(s.int2(2f64.powi(-7)), BigInt::from(2));
+        assert_eq!(s.int2(4.0), BigInt::from(1024));
+        let t = Scaled::with_squares([0.5], [0.0]);
+        assert_eq!(t.exponent(), -1);
+    }
+
+    #[test]
     fn determinants() {
         let a = [BigInt::from(2), BigInt::from(0), BigInt::from(1)];
         let b = [BigInt::from(1), BigInt::from(3), BigInt::from(2)];
         let c = [BigInt::from(1), BigInt::from(1), BigInt::from(2)];
         assert_eq!(det3(&a, &b, &c), BigInt::from(6));
+        assert_eq!(det::<3>([&a, &b, &c]), BigInt::from(6));
+        let (x, y) = (
+            [BigInt::from(2), BigInt::from(1)],
+            [BigInt::from(5), BigInt::from(4)],
+        );
+        assert_eq!(det::<2>([&x, &y]), BigInt::from(3));
         assert_eq!(sign(&BigInt::from(-4)), Sign::Negative);
     }
 }

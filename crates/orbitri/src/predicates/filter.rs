@@ -229,6 +229,70 @@ pub fn in_sphere_metric<const D: usize, const N: usize>(
     decide(inside, c * U * gsum * bmax * prod)
 }
 
+/// Power test of weighted points for rows `d_i = a_i − q` (bounds `b`, `N = D + 1`, `D` 2 or
+/// 3) and weight differences `dw_i = w_i − w_q` (each within `u` of the exact difference):
+/// positive when `q` is in conflict with the positively oriented `a_0..a_D`, i.e. its power
+/// distance to their orthogonal sphere is negative. The lifts are `l_i = |d_i|² − dw_i`;
+/// with equal weights this is the in-sphere determinant.
+///
+/// Bound: with `Λ_i = D·B_i² + |dw_i|`, each lift is off by at most `(12.1 + D + 3)u·Λ_i`
+/// (inputs, the sum of squares, `dw_i`, the subtraction); each minor's `D!` products of `D`
+/// entries by `(6.1D + D − 1 + D!)u` of `D!·Π_{j≠i}B_j`; a term `l_i·minor_i` by at most
+/// `50u·D!·Λ_i·Π_{j≠i}B_j` and the sum of the `N` terms by `Nu` of their magnitudes: below
+/// `330u·T` in 3D with `T = Σ_i Λ_i·Π_{j≠i}B_j`, bounded by `1024u·T`. Lifts outside
+/// `[2⁻⁴⁰⁰, 2⁴⁰⁰]` (unless zero) skip the filter, so nothing underflows or overflows.
+#[inline]
+pub fn power<const D: usize, const N: usize>(
+    d: &[[f64; D]; N],
+    b: [f64; N],
+    dw: [f64; N],
+) -> Option<Sign> {
+    if !b.iter().all(|&x| in_range(x)) {
+        return None;
+    }
+    let mut lambda = [0.0; N];
+    for i in 0..N {
+        lambda[i] = D as f64 * b[i] * b[i] + dw[i].abs();
+        if !(lambda[i] == 0.0 || (TINY * TINY..=HUGE * HUGE).contains(&lambda[i])) {
+            return None;
+        }
+    }
+    let l: [f64; N] = std::array::from_fn(|i| {
+        let mut s = 0.0;
+        for c in 0..D {
+            s += d[i][c] * d[i][c];
+        }
+        s - dw[i]
+    });
+    let mut det = 0.0;
+    let mut t = 0.0;
+    for (i, li) in l.iter().enumerate() {
+        let mut rows = [&[][..]; 3];
+        let mut others = 1.0;
+        for (slot, k) in (0..N).filter(|&k| k != i).enumerate() {
+            rows[slot] = &d[k][..];
+            others *= b[k];
+        }
+        t += lambda[i] * others;
+        let minor = if D == 2 {
+            rows[0][0] * rows[1][1] - rows[0][1] * rows[1][0]
+        } else {
+            rows[0][0] * (rows[1][1] * rows[2][2] - rows[1][2] * rows[2][1])
+                - rows[0][1] * (rows[1][0] * rows[2][2] - rows[1][2] * rows[2][0])
+                + rows[0][2] * (rows[1][0] * rows[2][1] - rows[1][1] * rows[2][0])
+        };
+        // cofactor sign along the last column of the (D+1)×(D+1) matrix
+        if (i + D) & 1 == 0 {
+            det += li * minor;
+        } else {
+            det -= li * minor;
+        }
+    }
+    // in conflict ⇔ the determinant has the sign of (−1)^D
+    let inside = if D & 1 == 0 { det } else { -det };
+    decide(inside, 1024.0 * U * t)
+}
+
 /// The sign of `det` when its error is below `err`; an exact zero when everything is zero.
 #[inline]
 fn decide(det: f64, err: f64) -> Option<Sign> {

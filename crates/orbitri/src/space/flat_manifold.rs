@@ -718,6 +718,54 @@ impl<const D: usize> FlatManifold<D> {
     }
 }
 
+impl<const D: usize> FlatManifold<D> {
+    /// The exact power test of lifted points of the stored frame, `Zero` when orthogonal.
+    /// (In a lattice frame it is evaluated exactly, without a filter.)
+    fn power_unperturbed<const N: usize>(
+        &self,
+        s: &[L<D>; N],
+        ws: &[f64; N],
+        q: L<D>,
+        wq: f64,
+    ) -> Sign {
+        match &self.lattice_frame {
+            None => self.fine.power_raw(s, ws, q, wq),
+            Some(f) => f.gram.power_exact(&f.unit, s, ws, q, wq),
+        }
+    }
+
+    /// The perturbation of a tie of the in-sphere or power test of `q` against `s` (lifted
+    /// to `ls` and `lq`): one global order, distinct points by their stored coordinates
+    /// (invariant under the group), copies of one point by their lifted positions (invariant
+    /// under translations: copies meet in one test only in a covering, whose group is
+    /// translations).
+    fn perturbed<const N: usize>(
+        &self,
+        s: &[(P<D>, Motion<D>); N],
+        ls: &[L<D>; N],
+        q: (P<D>, Motion<D>),
+        lq: L<D>,
+    ) -> Sign
+    where
+        FlatTorus<D>: OrbitSpace<N, Point = [f64; D], Elem = [i8; D]>,
+    {
+        let kernel = self.kernel();
+        let at = |k: usize| if k == N { (q.0, lq) } else { (s[k].0, ls[k]) };
+        perturbed_by(
+            ls,
+            lq,
+            |t| kernel.orient(t),
+            |a, b| {
+                let ((pa, la), (pb, lb)) = (at(a), at(b));
+                match pa.partial_cmp(&pb) {
+                    Some(std::cmp::Ordering::Equal) | None => kernel.compare_lifted(la, lb),
+                    Some(o) => Sign::from(o),
+                }
+            },
+        )
+    }
+}
+
 impl<const D: usize, const N: usize> OrbitSpace<N> for FlatManifold<D>
 where
     FlatTorus<D>: OrbitSpace<N, Point = [f64; D], Elem = [i8; D]> + UnperturbedInSphere<D, N>,
@@ -795,26 +843,7 @@ where
         let ls = self.lift_all(s);
         let lq = self.lift((&q.0, q.1));
         match self.in_sphere_unperturbed(&ls, lq) {
-            Sign::Zero => {
-                // one global order: distinct points by their stored coordinates (invariant
-                // under the group), copies of one point by their lifted positions (invariant
-                // under translations: copies meet in one test only in a covering, whose
-                // group is translations)
-                let kernel = self.kernel();
-                let at = |k: usize| if k == N { (q.0, lq) } else { (s[k].0, ls[k]) };
-                perturbed_by(
-                    &ls,
-                    lq,
-                    |t| kernel.orient(t),
-                    |a, b| {
-                        let ((pa, la), (pb, lb)) = (at(a), at(b));
-                        match pa.partial_cmp(&pb) {
-                            Some(std::cmp::Ordering::Equal) | None => kernel.compare_lifted(la, lb),
-                            Some(o) => Sign::from(o),
-                        }
-                    },
-                )
-            }
+            Sign::Zero => self.perturbed(s, &ls, q, lq),
             sign => sign,
         }
     }
@@ -828,12 +857,37 @@ where
             .coincide(self.lift((&a.0, a.1)), self.lift((&b.0, b.1)))
     }
 
-    fn circumradius2(&self, s: &[(P<D>, Motion<D>); N]) -> f64 {
-        self.fine.circumradius2(&self.cartesian_all(s))
+    fn power_test(
+        &self,
+        s: &[(P<D>, Motion<D>); N],
+        ws: &[f64; N],
+        q: (P<D>, Motion<D>),
+        wq: f64,
+    ) -> Sign {
+        let ls = self.lift_all(s);
+        let lq = self.lift((&q.0, q.1));
+        match self.power_unperturbed(&ls, ws, lq, wq) {
+            Sign::Zero => self.perturbed(s, &ls, q, lq),
+            sign => sign,
+        }
     }
 
-    fn circumcenter(&self, s: &[(P<D>, Motion<D>); N]) -> P<D> {
-        self.fine.circumcenter(&self.cartesian_all(s))
+    fn orthogonal(
+        &self,
+        s: &[(P<D>, Motion<D>); N],
+        ws: &[f64; N],
+        q: (P<D>, Motion<D>),
+        wq: f64,
+    ) -> bool {
+        self.power_unperturbed(&self.lift_all(s), ws, self.lift((&q.0, q.1)), wq) == Sign::Zero
+    }
+
+    fn ortho_distance2(&self, s: &[(P<D>, Motion<D>); N], ws: &[f64; N]) -> f64 {
+        self.fine.ortho_distance2(&self.cartesian_all(s), ws)
+    }
+
+    fn orthocenter(&self, s: &[(P<D>, Motion<D>); N], ws: &[f64; N]) -> P<D> {
+        self.fine.orthocenter(&self.cartesian_all(s), ws)
     }
 
     fn levels(&self) -> usize {

@@ -103,11 +103,23 @@ impl<const D: usize> FlatTorus<D> {
     /// [`Self::exact_lift`] and the exponent `e` of the scale: the integers are the
     /// coordinates divided by `2^e`.
     fn exact_lift_scaled(&self, pts: &[L<D>]) -> (Vec<[BigInt; D]>, i32) {
+        let (lifted, _, e) = self.exact_lift_weighted(pts, &[]);
+        (lifted, e)
+    }
+
+    /// The lifted points and the weights as exact integers, the points scaled by `2^-e`
+    /// and the weights (squared lengths) by `2^-2e`, and `e`.
+    pub(super) fn exact_lift_weighted(
+        &self,
+        pts: &[L<D>],
+        weights: &[f64],
+    ) -> (Vec<[BigInt; D]>, Vec<BigInt>, i32) {
         let m = &self.lattice.rows.m;
-        let scale = Scaled::new(
+        let scale = Scaled::with_squares(
             pts.iter()
                 .flat_map(|(p, _)| p.iter().copied())
                 .chain(m.iter().flatten().copied()),
+            weights.iter().copied(),
         );
         let mi: Vec<[BigInt; D]> = m.iter().map(|r| r.map(|x| scale.int(x))).collect();
         let lifted = pts
@@ -124,7 +136,54 @@ impl<const D: usize> FlatTorus<D> {
                 })
             })
             .collect();
-        (lifted, scale.exponent())
+        let w = weights.iter().map(|&x| scale.int2(x)).collect();
+        (lifted, w, scale.exponent())
+    }
+
+    /// The power test without perturbation (`Zero` when `q` is orthogonal to the
+    /// orthogonal sphere of `s`), exact; see [`filter::power`].
+    #[inline]
+    pub(super) fn power_raw<const N: usize>(
+        &self,
+        s: &[L<D>; N],
+        ws: &[f64; N],
+        q: L<D>,
+        wq: f64,
+    ) -> Sign {
+        let (d, b) = self.rows::<N>(std::array::from_fn(|i| &s[i]), &q);
+        let dw: [f64; N] = std::array::from_fn(|i| ws[i] - wq);
+        filter::power(&d, b, dw).unwrap_or_else(|| self.power_exact(s, ws, q, wq))
+    }
+
+    fn power_exact<const N: usize>(&self, s: &[L<D>; N], ws: &[f64; N], q: L<D>, wq: f64) -> Sign {
+        let mut pts = s.to_vec();
+        pts.push(q);
+        let mut weights = ws.to_vec();
+        weights.push(wq);
+        let (l, w, _) = self.exact_lift_weighted(&pts, &weights);
+        let d: Vec<[BigInt; D]> = (0..N)
+            .map(|i| std::array::from_fn(|c| &l[i][c] - &l[N][c]))
+            .collect();
+        let mut det = BigInt::from(0);
+        for i in 0..N {
+            let lift = d[i].iter().map(|x| x * x).sum::<BigInt>() - (&w[i] - &w[N]);
+            let mut rows = [&d[0]; D];
+            for (slot, k) in (0..N).filter(|&k| k != i).enumerate() {
+                rows[slot] = &d[k];
+            }
+            let term = lift * exact::det::<D>(rows);
+            if (i + D) & 1 == 0 {
+                det += term;
+            } else {
+                det -= term;
+            }
+        }
+        let sign = exact::sign(&det);
+        if D & 1 == 0 {
+            sign
+        } else {
+            sign.flip()
+        }
     }
 
     /// The lifted difference `a − b` in Cartesian coordinates, to within `6u` of its
@@ -142,18 +201,21 @@ impl<const D: usize> FlatTorus<D> {
     pub(super) fn certified_center<const N: usize>(
         &self,
         s: &[L<D>; N],
+        ws: &[f64; N],
         tolerance: f64,
         polynomials: CenterPolynomials<D>,
-        exact: impl Fn(&[[BigInt; D]; D]) -> ([BigInt; D], BigInt),
+        exact: impl Fn(&[[BigInt; D]; D], &[BigInt; D]) -> ([BigInt; D], BigInt),
     ) -> [f64; D] {
         let (d, b) = self.rows(std::array::from_fn(|i| &s[i + 1]), &s[0]);
-        if let Some(x) = filtered_center(&d, &b, tolerance, polynomials) {
+        let w: [f64; D] = std::array::from_fn(|i| ws[i + 1] - ws[0]);
+        if let Some(x) = filtered_center(&d, &b, &w, tolerance, polynomials) {
             return x;
         }
-        let (l, e) = self.exact_lift_scaled(s);
+        let (l, wi, e) = self.exact_lift_weighted(s, ws);
         let rows: [[BigInt; D]; D] =
             std::array::from_fn(|i| std::array::from_fn(|c| &l[i + 1][c] - &l[0][c]));
-        let (num, det) = exact(&rows);
+        let dw: [BigInt; D] = std::array::from_fn(|i| &wi[i + 1] - &wi[0]);
+        let (num, det) = exact(&rows, &dw);
         if det == BigInt::from(0) {
             return [f64::INFINITY; D];
         }
@@ -429,11 +491,13 @@ where
     }
 }
 
-/// The circumcenter polynomials of a simplex's edge vectors `d` (rows, from vertex 0): the
-/// circumcenter is `numerator / (2·det)`. `minus` is subtraction; evaluated with addition
-/// on magnitudes, the same expression bounds every monomial (for the error bound).
+/// The orthocenter polynomials of a simplex's edge vectors `d` (rows, from vertex 0) and
+/// weight differences `w` (`w_i − w_0`; zero for the circumcenter): the center is
+/// `numerator / (2·det)`, with the lifts `|d_i|² − w_i` in place of the squared lengths.
+/// `minus` is subtraction; evaluated with addition on magnitudes, the same expression
+/// bounds every monomial (for the error bound).
 pub(super) type CenterPolynomials<const D: usize> =
-    fn(&[[f64; D]; D], fn(f64, f64) -> f64) -> ([f64; D], f64);
+    fn(&[[f64; D]; D], &[f64; D], fn(f64, f64) -> f64) -> ([f64; D], f64);
 
 /// A circumcenter accepted when its certified error is below this fraction of its
 /// magnitude and of the simplex's extent.
@@ -447,7 +511,8 @@ pub(super) const RADIUS_TOLERANCE: f64 = 1.0 / (1u64 << 30) as f64;
 
 /// The floating-point circumcenter when its error bound allows, else `None`.
 ///
-/// Bound: each entry of `d` is within `e_i = 6u·b_i` of the exact lifted difference. For a
+/// Bound: each entry of `d` is within `e_i = 6u·b_i` of the exact lifted difference, each
+/// weight difference `w_i` within `u·|w_i|` of the exact one. For a
 /// polynomial `P` and `Q` its expression evaluated with `+` on magnitudes, `|P(x) − P(x̃)| ≤
 /// Q(|x̃| + e) − Q(|x̃|)` (every monomial holding an error term), and the rounding of `P(x̃)`
 /// is at most `γ_k·Q(|x̃|)`, `k ≤ 8` roundings deep; computing each `Q` value rounds at
@@ -456,6 +521,7 @@ pub(super) const RADIUS_TOLERANCE: f64 = 1.0 / (1u64 << 30) as f64;
 fn filtered_center<const D: usize>(
     d: &[[f64; D]; D],
     b: &[f64; D],
+    w: &[f64; D],
     tolerance: f64,
     polynomials: CenterPolynomials<D>,
 ) -> Option<[f64; D]> {
@@ -468,12 +534,18 @@ fn filtered_center<const D: usize>(
     let gamma = 9.0 * U;
     let minus = |x: f64, y: f64| x - y;
     let plus = |x: f64, y: f64| x + y;
-    let (num, det) = polynomials(d, minus);
+    let (num, det) = polynomials(d, w, minus);
     let magnitude = d.map(|r| r.map(f64::abs));
     let widened: [[f64; D]; D] =
         std::array::from_fn(|i| magnitude[i].map(|x| x + 6.0 * U * b[i] * (1.0 + 2.0 * U)));
-    let (num0, det0) = polynomials(&magnitude, plus);
-    let (num1, det1) = polynomials(&widened, plus);
+    // a weight difference is within `u` of its magnitude
+    let wm = w.map(f64::abs);
+    let ww = wm.map(|x| x * (1.0 + 2.0 * U));
+    if !wm.iter().all(|x| x.is_finite() && *x <= huge * huge) {
+        return None;
+    }
+    let (num0, det0) = polynomials(&magnitude, &wm, plus);
+    let (num1, det1) = polynomials(&widened, &ww, plus);
     // γ for evaluating P, one for each of the two Q, and the rounding of the widened inputs
     let err = |q0: f64, q1: f64| ((q1 - q0) + 4.0 * gamma * q1) * (1.0 + 4.0 * U);
     let den = 2.0 * det;
@@ -603,6 +675,107 @@ pub(super) use flat_torus_plugin;
 mod tests {
     use super::*;
     use crate::space::OrbitSpace;
+
+    fn random(seed: &mut u64) -> f64 {
+        *seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (*seed >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// The power test against random lifted simplices of a triclinic torus: equal weights
+    /// give the in-sphere answer; the filter agrees with the exact evaluation; the
+    /// orthocenter has one power distance to every vertex; and the answer is the sign of
+    /// the query's power distance to the orthogonal sphere, computed independently in
+    /// floating point where that is far from zero.
+    fn power_checks<const D: usize, const N: usize>(t: &FlatTorus<D>)
+    where
+        FlatTorus<D>: OrbitSpace<N, Point = [f64; D], Elem = [i8; D]>,
+    {
+        let mut seed = 7u64;
+        let mut decided = 0;
+        for _ in 0..3000 {
+            let mut lifted = |seed: &mut u64| -> L<D> {
+                let p = std::array::from_fn(|_| random(seed));
+                let o = std::array::from_fn(|_| (random(seed) * 3.0) as i8 - 1);
+                (p, o)
+            };
+            let mut s: [L<D>; N] = std::array::from_fn(|_| lifted(&mut seed));
+            if t.orient(&s) == Sign::Negative {
+                s.swap(0, 1);
+            }
+            if t.orient(&s) != Sign::Positive {
+                continue;
+            }
+            let q = lifted(&mut seed);
+            let ws: [f64; N] = std::array::from_fn(|_| random(&mut seed) * 0.3);
+            let wq = random(&mut seed) * 0.3;
+            let same = [0.25; N];
+            assert_eq!(t.power_test(&s, &same, q, 0.25), t.in_sphere(&s, q));
+            assert_eq!(t.power_raw(&s, &ws, q, wq), t.power_exact(&s, &ws, q, wq));
+            let z = t.orthocenter(&s, &ws);
+            let pos = s.map(|x| t.position(x));
+            let power = |x: [f64; D], w: f64| -> f64 {
+                (0..D)
+                    .map(|c| (x[c] - pos[0][c] - z[c]).powi(2))
+                    .sum::<f64>()
+                    - w
+            };
+            let rho = power(pos[0], ws[0]);
+            for i in 1..N {
+                assert!((power(pos[i], ws[i]) - rho).abs() < 1e-9 * (1.0 + rho.abs()));
+            }
+            let pq = power(t.position(q), wq) - rho;
+            if pq.abs() > 1e-6 * (1.0 + rho.abs()) {
+                let want = if pq < 0.0 {
+                    Sign::Positive
+                } else {
+                    Sign::Negative
+                };
+                assert_eq!(t.power_test(&s, &ws, q, wq), want);
+                decided += 1;
+            }
+            let d2 = t.ortho_distance2(&s, &ws);
+            assert!((d2 - (rho + ws[0])).abs() < 1e-6 * d2.max(1.0));
+        }
+        assert!(decided > 1000);
+    }
+
+    #[test]
+    fn power_tests_on_triclinic_tori() {
+        power_checks::<3, 4>(
+            &FlatTorus3::triclinic([[1.0, 0.0, 0.0], [0.3, 0.9, 0.0], [0.2, -0.1, 1.1]]).unwrap(),
+        );
+        power_checks::<2, 3>(&FlatTorus2::triclinic([[1.0, 0.0], [0.4, 0.8]]).unwrap());
+    }
+
+    /// A weighted point placed on a vertex conflicts exactly when its weight is larger;
+    /// weights far below the filter's reach and exact ties fall to the exact evaluation.
+    #[test]
+    fn power_ties_and_tiny_weights() {
+        let t = FlatTorus3::cuboid([1.0; 3]).unwrap();
+        let z = [0i8; 3];
+        let s = [
+            ([0.1, 0.1, 0.1], z),
+            ([0.6, 0.1, 0.1], z),
+            ([0.1, 0.6, 0.1], z),
+            ([0.1, 0.1, 0.6], z),
+        ];
+        let ws = [0.01, 0.02, 0.0, 0.03];
+        let on_vertex = ([0.6, 0.1, 0.1], z);
+        assert_eq!(t.power_test(&s, &ws, on_vertex, 0.03), Sign::Positive);
+        assert_eq!(t.power_test(&s, &ws, on_vertex, 0.01), Sign::Negative);
+        assert!(t.orthogonal(&s, &ws, on_vertex, 0.02));
+        // the whole configuration one period away
+        let s1 = s.map(|(p, _)| (p, [1, 0, -1]));
+        assert!(t.orthogonal(&s1, &ws, ([0.6, 0.1, 0.1], [1, 0, -1]), 0.02));
+        assert!(!t.orthogonal(&s1, &ws, on_vertex, 0.02));
+        let tiny = [1e-300, 0.0, 3e-310, 0.0];
+        assert_eq!(
+            t.power_test(&s, &tiny, ([0.2, 0.2, 0.2], z), 0.0),
+            t.in_sphere(&s, ([0.2, 0.2, 0.2], z))
+        );
+    }
 
     /// The torus's one-subtraction `relative` and `carry` are the group's `b⁻¹∘a` and
     /// `to∘from⁻¹`, and both are invariant under translating by a common element, as the

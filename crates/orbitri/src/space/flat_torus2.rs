@@ -17,9 +17,10 @@ type L2 = L<2>;
 impl FlatTorus<2> {
     /// The circumcenter relative to vertex 0, certified to within `tolerance` (see
     /// [`FlatTorus::certified_center`]).
-    fn center_within(&self, s: &[L2; 3], tolerance: f64) -> [f64; 2] {
-        self.certified_center(s, tolerance, center_polynomials, |d| {
-            let l = d.each_ref().map(|r| &r[0] * &r[0] + &r[1] * &r[1]);
+    fn center_within(&self, s: &[L2; 3], ws: &[f64; 3], tolerance: f64) -> [f64; 2] {
+        self.certified_center(s, ws, tolerance, center_polynomials, |d, w| {
+            let l: [BigInt; 2] =
+                std::array::from_fn(|i| &d[i][0] * &d[i][0] + &d[i][1] * &d[i][1] - &w[i]);
             let det = &d[0][0] * &d[1][1] - &d[0][1] * &d[1][0];
             let num = [
                 &l[0] * &d[1][1] - &l[1] * &d[0][1],
@@ -55,9 +56,14 @@ impl FlatTorus<2> {
     }
 }
 
-/// The circumcenter `(l_0 d_1⊥ − l_1 d_0⊥) / (2·det)` of the edge vectors `d` (Cramer's rule).
-fn center_polynomials(d: &[[f64; 2]; 2], minus: fn(f64, f64) -> f64) -> ([f64; 2], f64) {
-    let l = d.map(|r| r[0] * r[0] + r[1] * r[1]);
+/// The orthocenter `(l_0 d_1⊥ − l_1 d_0⊥) / (2·det)` of the edge vectors `d` with lifts
+/// `l_i = |d_i|² − w_i` (Cramer's rule; the circumcenter for zero weights).
+fn center_polynomials(
+    d: &[[f64; 2]; 2],
+    w: &[f64; 2],
+    minus: fn(f64, f64) -> f64,
+) -> ([f64; 2], f64) {
+    let l: [f64; 2] = std::array::from_fn(|i| minus(d[i][0] * d[i][0] + d[i][1] * d[i][1], w[i]));
     let det = minus(d[0][0] * d[1][1], d[0][1] * d[1][0]);
     (
         [
@@ -95,13 +101,25 @@ impl OrbitSpace<3> for FlatTorus<2> {
         }
     }
 
-    fn circumradius2(&self, s: &[L2; 3]) -> f64 {
-        let x = self.center_within(s, RADIUS_TOLERANCE);
+    #[inline(always)]
+    fn power_test(&self, s: &[L2; 3], ws: &[f64; 3], q: L2, wq: f64) -> Sign {
+        match self.power_raw(s, ws, q, wq) {
+            Sign::Zero => self.perturbed(s, q, |t| self.orient(t)),
+            sign => sign,
+        }
+    }
+
+    fn orthogonal(&self, s: &[L2; 3], ws: &[f64; 3], q: L2, wq: f64) -> bool {
+        self.power_raw(s, ws, q, wq) == Sign::Zero
+    }
+
+    fn ortho_distance2(&self, s: &[L2; 3], ws: &[f64; 3]) -> f64 {
+        let x = self.center_within(s, ws, RADIUS_TOLERANCE);
         x[0] * x[0] + x[1] * x[1]
     }
 
-    fn circumcenter(&self, s: &[L2; 3]) -> [f64; 2] {
-        self.center_within(s, CENTER_TOLERANCE)
+    fn orthocenter(&self, s: &[L2; 3], ws: &[f64; 3]) -> [f64; 2] {
+        self.center_within(s, ws, CENTER_TOLERANCE)
     }
 
     const KEY_BITS: u32 = 32;

@@ -16,11 +16,11 @@ type L3 = L<3>;
 impl FlatTorus<3> {
     /// The circumcenter relative to vertex 0, certified to within `tolerance` (see
     /// [`FlatTorus::certified_center`]).
-    fn center_within(&self, s: &[L3; 4], tolerance: f64) -> [f64; 3] {
-        self.certified_center(s, tolerance, center_polynomials, |d| {
-            let l = d
-                .each_ref()
-                .map(|r| &r[0] * &r[0] + &r[1] * &r[1] + &r[2] * &r[2]);
+    fn center_within(&self, s: &[L3; 4], ws: &[f64; 4], tolerance: f64) -> [f64; 3] {
+        self.certified_center(s, ws, tolerance, center_polynomials, |d, w| {
+            let l: [BigInt; 3] = std::array::from_fn(|i| {
+                &d[i][0] * &d[i][0] + &d[i][1] * &d[i][1] + &d[i][2] * &d[i][2] - &w[i]
+            });
             let cross = |a: &[BigInt; 3], b: &[BigInt; 3]| -> [BigInt; 3] {
                 [
                     &a[1] * &b[2] - &a[2] * &b[1],
@@ -72,9 +72,19 @@ impl FlatTorus<3> {
     }
 }
 
-/// The circumcenter `Σ l_i (d_j × d_k) / (2·det)` of the edge vectors `d` (Cramer's rule).
-fn center_polynomials(d: &[[f64; 3]; 3], minus: fn(f64, f64) -> f64) -> ([f64; 3], f64) {
-    let l = d.map(|r| r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
+/// The orthocenter `Σ l_i (d_j × d_k) / (2·det)` of the edge vectors `d` with lifts
+/// `l_i = |d_i|² − w_i` (Cramer's rule; the circumcenter for zero weights).
+fn center_polynomials(
+    d: &[[f64; 3]; 3],
+    w: &[f64; 3],
+    minus: fn(f64, f64) -> f64,
+) -> ([f64; 3], f64) {
+    let l: [f64; 3] = std::array::from_fn(|i| {
+        minus(
+            d[i][0] * d[i][0] + d[i][1] * d[i][1] + d[i][2] * d[i][2],
+            w[i],
+        )
+    });
     let cross = |a: &[f64; 3], b: &[f64; 3]| {
         [
             minus(a[1] * b[2], a[2] * b[1]),
@@ -121,13 +131,25 @@ impl OrbitSpace<4> for FlatTorus<3> {
         }
     }
 
-    fn circumradius2(&self, s: &[L3; 4]) -> f64 {
-        let x = self.center_within(s, RADIUS_TOLERANCE);
+    #[inline(always)]
+    fn power_test(&self, s: &[L3; 4], ws: &[f64; 4], q: L3, wq: f64) -> Sign {
+        match self.power_raw(s, ws, q, wq) {
+            Sign::Zero => self.perturbed(s, q, |t| self.orient(t)),
+            sign => sign,
+        }
+    }
+
+    fn orthogonal(&self, s: &[L3; 4], ws: &[f64; 4], q: L3, wq: f64) -> bool {
+        self.power_raw(s, ws, q, wq) == Sign::Zero
+    }
+
+    fn ortho_distance2(&self, s: &[L3; 4], ws: &[f64; 4]) -> f64 {
+        let x = self.center_within(s, ws, RADIUS_TOLERANCE);
         x[0] * x[0] + x[1] * x[1] + x[2] * x[2]
     }
 
-    fn circumcenter(&self, s: &[L3; 4]) -> [f64; 3] {
-        self.center_within(s, CENTER_TOLERANCE)
+    fn orthocenter(&self, s: &[L3; 4], ws: &[f64; 4]) -> [f64; 3] {
+        self.center_within(s, ws, CENTER_TOLERANCE)
     }
 
     const KEY_BITS: u32 = 63;

@@ -83,17 +83,40 @@ impl<const D: usize> Gram<D> {
     ) -> Sign {
         let (d, b) = unit.rows::<N>(std::array::from_fn(|i| &s[i]), &q);
         filter::in_sphere_metric(&d, b, &self.approx, self.sum)
-            .unwrap_or_else(|| self.in_sphere_exact(unit, s, q))
+            .unwrap_or_else(|| self.power_exact(unit, s, &[0.0; N], q, 0.0))
     }
 
-    fn in_sphere_exact<const N: usize>(&self, unit: &FlatTorus<D>, s: &[L<D>; N], q: L<D>) -> Sign {
+    /// The power test of weighted lifted points (lattice coordinates of `unit`, weights
+    /// squared Cartesian lengths) without perturbation: `Zero` when `q` is orthogonal to the
+    /// orthogonal sphere of `s`; the in-sphere test for equal weights. Exact.
+    pub(super) fn power_exact<const N: usize>(
+        &self,
+        unit: &FlatTorus<D>,
+        s: &[L<D>; N],
+        ws: &[f64; N],
+        q: L<D>,
+        wq: f64,
+    ) -> Sign {
         let mut pts = s.to_vec();
         pts.push(q);
-        let l = unit.exact_lift(&pts);
+        let (l, _, ed) = unit.exact_lift_weighted(&pts, &[]);
         let d: Vec<[BigInt; D]> = (0..N)
             .map(|i| std::array::from_fn(|c| &l[i][c] - &l[N][c]))
             .collect();
         let scale = Scaled::new(self.exact.iter().flatten().map(|e| e.1));
+        // squared lengths below are integers at 2^e; the weight differences at 2^ew
+        let e = 2 * (scale.exponent() + ed);
+        let dws: Vec<f64> = ws.iter().map(|w| w - wq).collect();
+        let wscale = Scaled::new(dws.iter().copied());
+        let (ew, lift_shift) = if wscale.exponent() >= e {
+            (e, 0)
+        } else {
+            (wscale.exponent(), (e - wscale.exponent()) as usize)
+        };
+        let dw: Vec<BigInt> = dws
+            .iter()
+            .map(|&x| wscale.int(x) << (wscale.exponent() - ew) as usize)
+            .collect();
         let g: Vec<Vec<BigInt>> = self
             .exact
             .iter()
@@ -114,6 +137,7 @@ impl<const D: usize> Gram<D> {
                     len += &g[j][k] * &d[i][j] * &d[i][k];
                 }
             }
+            let len = (len << lift_shift) - &dw[i];
             let rows: Vec<&[BigInt; D]> = (0..N).filter(|&k| k != i).map(|k| &d[k]).collect();
             let minor = if D == 2 {
                 &rows[0][0] * &rows[1][1] - &rows[0][1] * &rows[1][0]

@@ -83,12 +83,43 @@ pub trait OrbitSpace<const N: usize>: Sync + Send {
     /// Squared circumradius, certified to a relative accuracy of about `2^-28` (infinite for
     /// a flat simplex): enough for the switch criterion, whose radii carry a margin of
     /// `1e-7`, and cheaper than [`OrbitSpace::circumcenter`] for slivers.
-    fn circumradius2(&self, s: &[Lifted<Self::Point, Self::Elem>; N]) -> f64;
+    fn circumradius2(&self, s: &[Lifted<Self::Point, Self::Elem>; N]) -> f64 {
+        self.ortho_distance2(s, &[0.0; N])
+    }
     /// The circumcenter of the lifted simplex relative to its vertex 0, in Cartesian
     /// coordinates, certified: a floating-point evaluation whose error bound is below
     /// `2^-44` of its magnitude (and of the simplex's extent) is accepted, otherwise it is
     /// computed exactly and rounded. Infinite coordinates for a flat simplex.
-    fn circumcenter(&self, s: &[Lifted<Self::Point, Self::Elem>; N]) -> Self::Point;
+    fn circumcenter(&self, s: &[Lifted<Self::Point, Self::Elem>; N]) -> Self::Point {
+        self.orthocenter(s, &[0.0; N])
+    }
+    /// Exact, symbolically perturbed power test of weighted points: `Positive` when `q` of
+    /// weight `wq` is in conflict with the positively oriented `s` of weights `ws` (its
+    /// power distance `|q − z|² − wq` to their orthogonal sphere `(z, ρ)` is below `ρ`).
+    /// Ties are broken by the perturbation of [`OrbitSpace::in_sphere`], which with equal
+    /// weights it equals.
+    fn power_test(
+        &self,
+        s: &[Lifted<Self::Point, Self::Elem>; N],
+        ws: &[f64; N],
+        q: Lifted<Self::Point, Self::Elem>,
+        wq: f64,
+    ) -> Sign;
+    /// Exact test whether `q` is orthogonal to the orthogonal sphere of `s` (no
+    /// perturbation): the power-diagram vertices of such cells coincide.
+    fn orthogonal(
+        &self,
+        s: &[Lifted<Self::Point, Self::Elem>; N],
+        ws: &[f64; N],
+        q: Lifted<Self::Point, Self::Elem>,
+        wq: f64,
+    ) -> bool;
+    /// The orthocenter (center of the sphere orthogonal to every weighted vertex) relative
+    /// to vertex 0, certified as [`OrbitSpace::circumcenter`], which it is for equal weights.
+    fn orthocenter(&self, s: &[Lifted<Self::Point, Self::Elem>; N], ws: &[f64; N]) -> Self::Point;
+    /// The squared distance from the orthocenter to vertex 0, certified as
+    /// [`OrbitSpace::circumradius2`], which it is for equal weights.
+    fn ortho_distance2(&self, s: &[Lifted<Self::Point, Self::Elem>; N], ws: &[f64; N]) -> f64;
     /// Number of levels of the covering ladder: level 0 is a covering in which every
     /// non-empty point set has a Delaunay triangulation, each next level has fewer sheets, and
     /// the last is the orbit space itself (1 sheet).
