@@ -695,7 +695,7 @@ mod tests {
         let mut seed = 7u64;
         let mut decided = 0;
         for _ in 0..3000 {
-            let mut lifted = |seed: &mut u64| -> L<D> {
+            let lifted = |seed: &mut u64| -> L<D> {
                 let p = std::array::from_fn(|_| random(seed));
                 let o = std::array::from_fn(|_| (random(seed) * 3.0) as i8 - 1);
                 (p, o)
