@@ -274,9 +274,11 @@ fn insert_all<const D: usize, const N: usize, S: Served<D, N>>(
         .collect();
     Ok(t.insert_all(&points)?
         .into_iter()
-        .map(|r| {
-            let (orbitri::Inserted::New(v) | orbitri::Inserted::Duplicate(v)) = r;
-            i64::from(t.input_of_vertex(v).0)
+        .map(|r| match r {
+            orbitri::Inserted::New(v) | orbitri::Inserted::Duplicate(v) => {
+                i64::from(t.input_of_vertex(v).0)
+            }
+            orbitri::Inserted::Hidden => -1,
         })
         .collect())
 }

@@ -43,6 +43,28 @@ pub enum Error {
         #[source]
         source: std::io::Error,
     },
+    /// A weight (or radius) that is not a finite number, a negative radius, or a weight
+    /// beyond what the box's internal frame holds.
+    #[error("point {index}: {what} {value} {why}")]
+    BadWeight {
+        index: usize,
+        what: &'static str,
+        value: f64,
+        why: String,
+    },
+    /// Weights given for a number of points other than the points'.
+    #[error("{weights} weights for {points} points: give one weight (or radius) per point")]
+    WeightCount { points: usize, weights: usize },
+    /// The weights spread wider than any covering space of the box is proven safe for.
+    #[error(
+        "point {index}: weight {value:e} spreads the weights over {spread:e} (largest − least), more than this box allows ({limit:e}: the covering space would need more than 24 copies along a lattice vector); weights are squared lengths, compare them with the squared box size"
+    )]
+    WeightSpread {
+        index: usize,
+        value: f64,
+        spread: f64,
+        limit: f64,
+    },
     /// An input id the triangulation does not hold: never given, or removed.
     #[error("input id {id}: {why}")]
     UnknownInput { id: u64, why: String },

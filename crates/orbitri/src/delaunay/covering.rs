@@ -135,14 +135,35 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.set_guaranteed(true);
     }
 
+    /// Takes a space with other coverings (weighted points spread further): a quotient
+    /// stays where it is, its criterion examined again; a covering is rebuilt from the new
+    /// level 0.
+    pub(crate) fn replace_space(&mut self, space: S) {
+        self.space = space;
+        if self.points.is_empty() {
+            let w = self.weight_max;
+            self.clear();
+            self.weight_max = w;
+        } else if self.one_sheeted {
+            self.level = self.last_level();
+            self.guaranteed = false;
+            self.recount_big();
+        } else {
+            self.rebuild_in_covering();
+        }
+    }
+
     /// Rebuilds the triangulation of the current points at level 0.
     pub(crate) fn rebuild_in_covering(&mut self) {
         let pts = std::mem::take(&mut self.points);
+        let ws = std::mem::take(&mut self.weights);
+        let weight = |i: usize| ws.get(i).copied().unwrap_or(0.0);
         self.guaranteed = false;
-        self.points.push(pts[0]);
+        self.push_point(pts[0], weight(0));
         self.bootstrap_covering();
-        for &p in &pts[1..] {
-            self.insert(p);
+        // (no point is hidden: each was a vertex of a superset's triangulation)
+        for (i, &p) in pts.iter().enumerate().skip(1) {
+            self.insert_weighted(p, weight(i));
         }
     }
 
@@ -227,6 +248,9 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             .flat_map(|&g| std::iter::repeat_n(g, sheets as usize))
             .collect();
         drop_gone(&mut self.points, gone);
+        if self.weighted {
+            drop_gone(&mut self.weights, gone);
+        }
         drop_gone(&mut self.vcell, &vertex_gone);
         self.vpoint = (0..self.points.len() as u32)
             .flat_map(|p| std::iter::repeat_n(PointId(p), sheets as usize))

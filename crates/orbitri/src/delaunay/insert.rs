@@ -1,7 +1,7 @@
 //! Point location by a remembering stochastic walk, the conflict region by breadth-first
 //! search, and starring the hole.
 
-use super::{Engine, Inserted, LiftedOf};
+use super::{Engine, HiddenPoint, Inserted, LiftedOf};
 use crate::ids::{CellId, PointId, VertexId};
 use crate::predicates::Sign;
 use crate::sort::SplitMix;
@@ -13,6 +13,8 @@ pub(crate) enum Refused {
     Duplicate(VertexId),
     /// Starring its conflict region would break the quotient (1-sheeted without criterion).
     NotSimplicial,
+    /// Weighted: it conflicts with no cell (its power cell is empty).
+    Hidden,
 }
 
 impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
@@ -75,9 +77,24 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.walk((p, from.1), from.0, &mut SplitMix::new(0x10ca7e))
     }
 
-    /// Collects the cells whose circumsphere contains `q` (starting at `c0`, which contains
-    /// `q`) and the facets bounding them.
-    fn find_conflicts(&mut self, c0: CellId, q0: S::Elem, p: S::Point) {
+    /// True when the weighted point `p` of weight `w` would be a vertex if inserted (or a
+    /// duplicate): its power cell is not empty.
+    pub fn would_appear(&self, p: S::Point, w: f64) -> bool {
+        if self.points.is_empty() {
+            return true;
+        }
+        let (c, qo) = self.locate(p);
+        let vids = self.tds.cells[c.index()].v;
+        self.in_conflict(&self.lifted_cell(c), &vids, (p, qo), w)
+            || (0..N).any(|i| {
+                self.vertex_weight(vids[i]) == w && self.space.coincide(self.lifted(c, i), (p, qo))
+            })
+    }
+
+    /// Collects the cells in conflict with the point `p` of weight `wq` (whose circumsphere
+    /// contains it; for weighted points, of negative power distance), starting at `c0`,
+    /// which contains `p` lifted by `q0` and conflicts with it, and the facets bounding them.
+    fn find_conflicts(&mut self, c0: CellId, q0: S::Elem, p: S::Point, wq: f64) {
         let (inside, outside) = self.tds.new_visit();
         let mut scratch = std::mem::take(&mut self.scratch);
         scratch.conflict.clear();
@@ -95,7 +112,8 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 }
                 if st != outside {
                     let qd = self.space.relative(qo, self.translation(c, i, d));
-                    if self.space.in_sphere(&self.lifted_cell(d), (p, qd)) == Sign::Positive {
+                    let vids = self.tds.cells[d.index()].v;
+                    if self.in_conflict(&self.lifted_cell(d), &vids, (p, qd), wq) {
                         self.tds.set_stamp(d, inside);
                         self.tds.prefetch_neighbours(d);
                         scratch.conflict.push((d, qd));
@@ -169,11 +187,32 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 }
             }
         }
+        // weighted: a vertex of the region on none of its boundary facets is hidden; its
+        // vertex then points at no live cell once the new cells are attached
+        let first_hidden = scratch.hidden.len();
+        if self.weighted {
+            for &(c, _) in &scratch.conflict {
+                scratch.hidden.extend(self.tds.cells[c.index()].v);
+            }
+        }
         for &(c, _) in &scratch.conflict {
             self.kill_cell(c);
         }
         for &nc in &scratch.created {
             self.attach(nc);
+        }
+        if self.weighted {
+            let mut k = first_hidden;
+            for j in first_hidden..scratch.hidden.len() {
+                let v = scratch.hidden[j];
+                if !self.tds.is_alive(self.vcell[v.index()])
+                    && !scratch.hidden[first_hidden..k].contains(&v)
+                {
+                    scratch.hidden[k] = v;
+                    k += 1;
+                }
+            }
+            scratch.hidden.truncate(k);
         }
         let first = scratch.created[0];
         let k = self.tds.cells[first.index()]
@@ -194,7 +233,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             .scratch
             .conflict
             .iter()
-            .any(|&(c, _)| self.space.circumradius2(&self.lifted_cell(c)) >= limit)
+            .any(|&(c, _)| self.cell_radius2(c) >= limit)
         {
             return false;
         }
@@ -226,16 +265,28 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     ) -> Result<(), Refused> {
         let (start, shift) = from.unwrap_or_else(|| self.start_cell());
         let (c, qo) = self.locate_from((q.0, self.space.compose(shift, q.1)), start);
+        let wq = self.vertex_weight(x);
         if check_duplicate {
             for i in 0..N {
-                if self.space.coincide(self.lifted(c, i), (q.0, qo)) {
+                let v = self.tds.cells[c.index()].v[i];
+                // (a weighted point on another of a different weight hides it or is hidden)
+                if self.space.coincide(self.lifted(c, i), (q.0, qo)) && self.vertex_weight(v) == wq
+                {
                     self.hint = c;
                     self.hint_shift = self.space.carry(q.1, qo);
-                    return Err(Refused::Duplicate(self.tds.cells[c.index()].v[i]));
+                    return Err(Refused::Duplicate(v));
                 }
             }
         }
-        self.find_conflicts(c, qo, q.0);
+        if self.weighted {
+            let vids = self.tds.cells[c.index()].v;
+            if !self.in_conflict(&self.lifted_cell(c), &vids, (q.0, qo), wq) {
+                self.hint = c;
+                self.hint_shift = self.space.carry(q.1, qo);
+                return Err(Refused::Hidden);
+            }
+        }
+        self.find_conflicts(c, qo, q.0, wq);
         if self.one_sheeted && !self.guaranteed && !self.star_keeps_simplicial() {
             return Err(Refused::NotSimplicial);
         }
@@ -246,8 +297,52 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// Inserts a point of the domain. In the covering space every copy is inserted, and the
     /// triangulation switches to the 1-sheeted quotient as soon as the criterion holds.
     pub fn insert(&mut self, p: S::Point) -> Inserted {
+        self.insert_weighted(p, 0.0)
+    }
+
+    /// Inserts a point of weight `w` (ignored unless the triangulation is weighted). A
+    /// weighted point whose power cell is empty is [`Inserted::Hidden`]; the points it
+    /// hides leave the triangulation, each renumbering the last point into its id, and
+    /// are logged in `hidden_log`, in order.
+    pub fn insert_weighted(&mut self, p: S::Point, w: f64) -> Inserted {
+        self.scratch.hidden.clear();
+        self.insert_point(p, w)
+    }
+
+    /// After inserting point `pi`: drops the points whose vertices it hid, largest id
+    /// first (so that the last point, which takes a dropped id, is never hidden itself),
+    /// and returns the new point's id after that renumbering.
+    fn drop_hidden(&mut self, mut pi: PointId) -> PointId {
+        if self.scratch.hidden.is_empty() {
+            return pi;
+        }
+        let mut gone: Vec<PointId> = std::mem::take(&mut self.scratch.hidden)
+            .into_iter()
+            .map(|v| self.point_of(v))
+            .collect();
+        gone.sort_unstable_by(|a, b| b.cmp(a));
+        gone.dedup();
+        for p in gone {
+            self.hidden_log.push(HiddenPoint {
+                id: p,
+                point: self.points[p.index()],
+                weight: self.weights[p.index()],
+            });
+            let last = PointId::new(self.points.len() - 1);
+            self.renumber_last_point(p);
+            if last == pi {
+                pi = p;
+            }
+        }
+        if self.one_sheeted {
+            self.refill_locator();
+        }
+        pi
+    }
+
+    fn insert_point(&mut self, p: S::Point, w: f64) -> Inserted {
         if self.points.is_empty() {
-            self.points.push(p);
+            self.push_point(p, w);
             self.bootstrap_covering();
             return Inserted::New(PointId(0));
         }
@@ -255,12 +350,13 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         if self.one_sheeted {
             let key = self.space.spatial_key(&p);
             let from = self.insertion_start(key);
-            self.points.push(p);
+            self.push_point(p, w);
             self.vpoint.push(pi);
             self.vcell.push(CellId::NONE);
             // once 1-sheeted, the vertex of a point has its id
             match self.insert_lifted((p, self.space.identity()), VertexId(pi.0), true, from) {
                 Ok(()) => {
+                    let pi = self.drop_hidden(pi);
                     if !self.guaranteed && self.big_count == 0 {
                         self.set_guaranteed(true);
                     }
@@ -268,22 +364,23 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                     Inserted::New(pi)
                 }
                 Err(refused) => {
-                    self.points.pop();
+                    self.pop_point();
                     self.vpoint.pop();
                     self.vcell.pop();
                     match refused {
                         Refused::Duplicate(v) => Inserted::Duplicate(self.vpoint[v.index()]),
+                        Refused::Hidden => Inserted::Hidden,
                         Refused::NotSimplicial => {
                             // the quotient would stop being a triangulation: continue in
                             // the covering space
                             self.rebuild_in_covering();
-                            self.insert(p)
+                            self.insert_point(p, w)
                         }
                     }
                 }
             }
         } else {
-            self.points.push(p);
+            self.push_point(p, w);
             for k in 0..self.copies.len() {
                 let o = self.copies[k];
                 let x = VertexId::new(self.vpoint.len());
@@ -305,15 +402,20 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                     None => self.copy_hints.push(here),
                 }
                 if let Err(refused) = inserted {
-                    let Refused::Duplicate(v) = refused else {
-                        unreachable!("the covering is always a triangulation")
-                    };
-                    self.points.pop();
+                    // (refused on the first copy: the others are its images)
+                    self.pop_point();
                     self.vpoint.pop();
                     self.vcell.pop();
-                    return Inserted::Duplicate(self.vpoint[v.index()]);
+                    return match refused {
+                        Refused::Duplicate(v) => Inserted::Duplicate(self.vpoint[v.index()]),
+                        Refused::Hidden => Inserted::Hidden,
+                        Refused::NotSimplicial => {
+                            unreachable!("the covering is always a triangulation")
+                        }
+                    };
                 }
             }
+            let pi = self.drop_hidden(pi);
             self.descend();
             Inserted::New(pi)
         }

@@ -20,6 +20,7 @@ use crate::space::{Lifted, OrbitSpace};
 use crate::tds::{Cell, Tds};
 
 pub use remove::{Moved, Removal};
+
 pub use validate::Invalid;
 
 /// A lifted point of the space `S` (cells of `N` vertices).
@@ -39,6 +40,9 @@ struct Scratch<O> {
     boundary: Vec<(u32, u8)>,
     /// New cells, parallel to `boundary`.
     created: Vec<CellId>,
+    /// Weighted: the vertices an insertion hid (those of conflict cells on no boundary
+    /// facet), accumulated over the copies of a point.
+    hidden: Vec<VertexId>,
 }
 
 // (not derived: that would ask the group elements for a `Default`)
@@ -48,6 +52,7 @@ impl<O> Default for Scratch<O> {
             conflict: Vec::new(),
             boundary: Vec::new(),
             created: Vec::new(),
+            hidden: Vec::new(),
         }
     }
 }
@@ -57,8 +62,20 @@ impl<O> Default for Scratch<O> {
 pub enum Inserted {
     /// A new point (vertex of the quotient) with this id.
     New(PointId),
-    /// The point coincides with the existing point of this id.
+    /// The point coincides with the existing point of this id (and has its weight).
     Duplicate(PointId),
+    /// The weighted point is hidden: its power cell is empty, it has no vertex.
+    Hidden,
+}
+
+/// A point that an insertion hid (weighted triangulations): it left the triangulation, and
+/// the last point took its id, as in [`Engine::remove_point`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HiddenPoint<P> {
+    /// Its id when it was hidden.
+    pub id: PointId,
+    pub point: P,
+    pub weight: f64,
 }
 
 /// A Delaunay triangulation of an orbit space.
@@ -67,6 +84,18 @@ pub struct Engine<S: OrbitSpace<N>, const N: usize> {
     pub(crate) space: S,
     /// The distinct points (dummy points, while present, at the end).
     pub(crate) points: Vec<S::Point>,
+    /// A regular (weighted Delaunay) triangulation: the power test replaces the in-sphere
+    /// test, and points can be hidden.
+    pub(crate) weighted: bool,
+    /// Weighted: the weight of each point (squared length, internal frame).
+    pub(crate) weights: Vec<f64>,
+    /// Weighted: the largest weight inserted since the triangulation was emptied. A cell's
+    /// edges are shorter than twice `√(ρ + W − w)` for its orthogonal sphere's `ρ` and a
+    /// least weight `w` (thesis Lemma 2.3.10), so `|z − p_0|² + W − w_0` plays the squared
+    /// circumradius in the switch criterion (see [`Self::radius2`]).
+    pub(crate) weight_max: f64,
+    /// Weighted: the points the insertions since the caller last looked hid, in order.
+    pub(crate) hidden_log: Vec<HiddenPoint<S::Point>>,
     /// Vertex → its point (1-sheeted: the identity; covering: one vertex per copy).
     pub(crate) vpoint: Vec<PointId>,
     /// Vertex → one incident cell.
@@ -111,6 +140,10 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             big_limit: 0.0,
             space,
             points: Vec::new(),
+            weighted: false,
+            weights: Vec::new(),
+            weight_max: f64::NEG_INFINITY,
+            hidden_log: Vec::new(),
             vpoint: Vec::new(),
             vcell: Vec::new(),
             tds: Tds::new(),
@@ -134,6 +167,8 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     pub(crate) fn clear(&mut self) {
         let last = self.space.levels() - 1;
         self.points.clear();
+        self.weights.clear();
+        self.weight_max = f64::NEG_INFINITY;
         self.vpoint.clear();
         self.vcell.clear();
         self.tds.clear();
@@ -147,6 +182,103 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.hint = CellId(0);
         self.hint_shift = self.space.identity();
         self.copy_hints.clear();
+    }
+
+    /// An empty regular (weighted Delaunay) triangulation of the space: points come with
+    /// weights ([`Self::insert_weighted`]) and may be hidden.
+    pub fn new_weighted(space: S) -> Self {
+        let mut e = Self::new(space);
+        e.weighted = true;
+        e
+    }
+
+    /// True for a regular (weighted) triangulation.
+    pub fn is_weighted(&self) -> bool {
+        self.weighted
+    }
+
+    /// The weights of the points (internal frame; empty when unweighted).
+    pub fn weights(&self) -> &[f64] {
+        &self.weights
+    }
+
+    /// The weight of vertex `v` (0 when unweighted).
+    #[inline(always)]
+    pub fn vertex_weight(&self, v: VertexId) -> f64 {
+        if self.weighted {
+            self.weights[self.point_index(v)]
+        } else {
+            0.0
+        }
+    }
+
+    /// The weights of the vertices of cell `c` (zeros when unweighted).
+    #[inline]
+    pub fn cell_weights(&self, c: CellId) -> [f64; N] {
+        self.tds.cells[c.index()].v.map(|v| self.vertex_weight(v))
+    }
+
+    /// True when the lifted point `q` of weight `wq` conflicts with the positively oriented
+    /// lifted simplex `s` of vertices `vids`: inside its circumsphere, or for weighted
+    /// points of negative power distance to its orthogonal sphere (perturbed: never a tie).
+    #[inline(always)]
+    pub(crate) fn in_conflict(
+        &self,
+        s: &LiftedCell<S, N>,
+        vids: &[VertexId; N],
+        q: LiftedOf<S, N>,
+        wq: f64,
+    ) -> bool {
+        if self.weighted {
+            let ws = vids.map(|v| self.vertex_weight(v));
+            self.space.power_test(s, &ws, q, wq) == Sign::Positive
+        } else {
+            self.space.in_sphere(s, q) == Sign::Positive
+        }
+    }
+
+    /// What the switch criterion compares with the squared radii of the ladder: the
+    /// squared circumradius, or for weighted points `|z − p_0|² + W − w_0` (`z` the
+    /// orthocenter, `W` the largest weight), which bounds a quarter of the squared length
+    /// of any edge the cell's orthogonal sphere allows.
+    #[inline]
+    pub(crate) fn radius2(&self, s: &LiftedCell<S, N>, vids: &[VertexId; N]) -> f64 {
+        if self.weighted {
+            let ws = vids.map(|v| self.vertex_weight(v));
+            self.space.ortho_distance2(s, &ws) + (self.weight_max - ws[0])
+        } else {
+            self.space.circumradius2(s)
+        }
+    }
+
+    /// [`Self::radius2`] of a stored cell.
+    fn cell_radius2(&self, c: CellId) -> f64 {
+        self.radius2(&self.lifted_cell(c), &self.tds.cells[c.index()].v)
+    }
+
+    /// Appends a point (and its weight when weighted).
+    fn push_point(&mut self, p: S::Point, w: f64) {
+        self.points.push(p);
+        if self.weighted {
+            self.weights.push(w);
+            if w > self.weight_max {
+                // the criterion was known for a smaller spread of weights
+                self.weight_max = w;
+                if self.guaranteed {
+                    self.set_guaranteed(false);
+                } else if !self.tds.is_empty() {
+                    self.recount_big();
+                }
+            }
+        }
+    }
+
+    /// Drops the last point (and its weight).
+    fn pop_point(&mut self) {
+        self.points.pop();
+        if self.weighted {
+            self.weights.pop();
+        }
     }
 
     /// Reserves room for about `cells` cells and `points` points (bulk construction).
@@ -391,7 +523,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
 
     /// Records whether cell `c` is too large for the criterion of the next level.
     fn track(&mut self, c: CellId) {
-        let big = self.space.circumradius2(&self.lifted_cell(c)) >= self.big_limit;
+        let big = self.cell_radius2(c) >= self.big_limit;
         if self.big.len() <= c.index() {
             self.big.resize(c.index() + 1, false);
         }

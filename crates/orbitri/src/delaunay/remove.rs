@@ -66,6 +66,9 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             return Removal::InPlace;
         }
         self.points.swap_remove(p.index());
+        if self.weighted {
+            self.weights.swap_remove(p.index());
+        }
         self.rebuild_in_covering();
         Removal::Rebuilt
     }
@@ -95,6 +98,9 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         // (removed vertices and the one refused are all dropped with the others)
         let map = renumbering(&gone);
         drop_gone(&mut self.points, &gone);
+        if self.weighted {
+            drop_gone(&mut self.weights, &gone);
+        }
         self.rebuild_in_covering();
         (map, true)
     }
@@ -112,7 +118,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
 
     /// After the vertices of point `p` were removed: the last point moves into its slot,
     /// each of its vertices (one per sheet) renamed in the cells around it.
-    fn renumber_last_point(&mut self, p: PointId) {
+    pub(super) fn renumber_last_point(&mut self, p: PointId) {
         let last = self.points.len() - 1;
         let sheets = self.space.sheets(self.level);
         if p.index() != last {
@@ -125,8 +131,11 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 self.vcell[to.index()] = self.vcell[from.index()];
             }
             self.points[p.index()] = self.points[last];
+            if self.weighted {
+                self.weights[p.index()] = self.weights[last];
+            }
         }
-        self.points.pop();
+        self.pop_point();
         self.vpoint.truncate(last * sheets);
         self.vcell.truncate(last * sheets);
     }
@@ -141,7 +150,13 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             return Moved::Coordinates;
         }
         let v = self.vertex_of_point(p);
-        if !self.one_sheeted || self.points.len() == 1 || self.remove_vertex(v).is_err() {
+        // (a weighted move may hide points or uncover hidden ones: the caller removes and
+        // inserts)
+        if self.weighted
+            || !self.one_sheeted
+            || self.points.len() == 1
+            || self.remove_vertex(v).is_err()
+        {
             return Moved::Refused;
         }
         self.points[p.index()] = to;
@@ -164,6 +179,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 self.rebuild_in_covering();
                 Moved::Rebuilt
             }
+            Err(Refused::Hidden) => unreachable!("only weighted points are hidden"),
         }
     }
 
@@ -174,7 +190,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// star then stays a star-shaped triangulation around `to`, so `to` meets no other
     /// point. Returns false, with nothing changed, otherwise (then remove and insert).
     pub fn try_move(&mut self, p: PointId, to: S::Point) -> bool {
-        if !(self.one_sheeted && self.guaranteed) {
+        if !(self.one_sheeted && self.guaranteed) || self.weighted {
             return false;
         }
         let v = self.vertex_of_point(p);
@@ -248,10 +264,8 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             .wrap(seeds, |_, _, _| Cow::Borrowed(&hole[..]), Vec::new(), false)
             .ok_or(RemoveError::NotSimplicial)?;
         let limit = self.space.criterion_radius2(self.level);
-        let breaks = limit.is_finite()
-            && cells
-                .iter()
-                .any(|w| self.space.circumradius2(&w.arr) >= limit);
+        let breaks =
+            limit.is_finite() && cells.iter().any(|w| self.radius2(&w.arr, &w.vids) >= limit);
         if !self.one_sheeted {
             if breaks {
                 return Err(RemoveError::NotSimplicial);

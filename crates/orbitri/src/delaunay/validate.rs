@@ -60,7 +60,12 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 }
                 let q = self.lifted(d, j);
                 let q = (q.0, self.space.compose(t.unwrap(), q.1));
-                if self.space.in_sphere(&self.lifted_cell(c), q) == Sign::Positive {
+                if self.in_conflict(
+                    &self.lifted_cell(c),
+                    &cell.v,
+                    q,
+                    self.vertex_weight(dc.v[j]),
+                ) {
                     return bad(format!(
                         "cell {c} is not locally Delaunay: vertex {} of cell {d} is inside",
                         dc.v[j]

@@ -61,7 +61,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         } else {
             Sign::Negative
         };
-        let mut best: Option<(VertexId, LiftedCell<S, N>)> = None;
+        let mut best: Option<(VertexId, LiftedCell<S, N>, [VertexId; N])> = None;
         for &(vid, y) in cands {
             if f.vids
                 .iter()
@@ -75,15 +75,18 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             if self.space.orient(&s) != want {
                 continue;
             }
+            let mut vids = f.vids;
+            vids[f.idx] = vid;
             if !f.toward {
                 s.swap((f.idx + 1) % N, (f.idx + 2) % N);
+                vids.swap((f.idx + 1) % N, (f.idx + 2) % N);
             }
             match &best {
-                Some((_, b)) if self.space.in_sphere(b, y) != Sign::Positive => {}
-                _ => best = Some((vid, s)),
+                Some((_, b, bv)) if !self.in_conflict(b, bv, y, self.vertex_weight(vid)) => {}
+                _ => best = Some((vid, s, vids)),
             }
         }
-        best
+        best.map(|(vid, s, _)| (vid, s))
     }
 
     /// Closes every facet of `open` (and every facet the new cells leave open); the apex of
@@ -248,7 +251,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 }
                 if self.space.circumradius2(&s) <= max_r2
                     && others.iter().all(|&(v, y)| {
-                        vids.contains(&v) || self.space.in_sphere(&s, y) != Sign::Positive
+                        vids.contains(&v) || !self.in_conflict(&s, &vids, y, self.vertex_weight(v))
                     })
                 {
                     return Some(Wrapped {

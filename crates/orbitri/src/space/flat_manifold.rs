@@ -1126,6 +1126,20 @@ where
         least_translate::<Self, N>(self, pairs)
     }
 
+    fn weight_to_internal(&self, w: f64) -> f64 {
+        self.fine.lattice().measure_to_internal(w, 2)
+    }
+
+    /// Equal weights only: a manifold's covering and criterion for a spread of weights
+    /// are not derived (weighted points with a spread are for the flat tori).
+    fn for_spread(&self, spread: f64) -> Option<Self> {
+        (spread == 0.0).then(|| self.clone())
+    }
+
+    fn max_spread(&self) -> f64 {
+        0.0
+    }
+
     fn volume(&self) -> f64 {
         FlatManifold::volume(self)
     }

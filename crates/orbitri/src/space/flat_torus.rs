@@ -27,6 +27,10 @@ pub(super) type L<const D: usize> = Lifted<[f64; D], [i8; D]>;
 pub struct FlatTorus<const D: usize> {
     pub(super) lattice: Lattice<D>,
     ladder: Vec<Level<D>>,
+    kind: Ladder,
+    /// The spread of the weights (largest − least, internal frame) the ladder and the dummy
+    /// points are safe for: 0 unless built by [`FlatTorus::for_spread`].
+    spread: f64,
 }
 
 /// The 2D flat torus.
@@ -66,7 +70,65 @@ impl<const D: usize> FlatTorus<D> {
     /// The torus of a lattice with a chosen covering ladder.
     pub fn with_ladder(lattice: Lattice<D>, kind: Ladder) -> Self {
         let ladder = lattice.ladder(kind);
-        FlatTorus { lattice, ladder }
+        FlatTorus {
+            lattice,
+            ladder,
+            kind,
+            spread: 0.0,
+        }
+    }
+
+    /// The torus for weighted points whose weights spread over `spread` (largest − least,
+    /// internal frame), `None` when no covering is proven safe for it.
+    ///
+    /// The condition (thesis Lemma 2.3.10 with any lattice): a cell's orthogonal sphere
+    /// `(z, ρ)` puts each vertex `p` at `|p − z|² = ρ + w_p`, so its edges are shorter than
+    /// `2√(ρ + W)` when weights are shifted to a least weight 0 and `W` is the spread. One
+    /// point leaves orthogonal spheres with `ρ ≤ μ²` (`μ` the lattice's covering radius,
+    /// `2μ ≤ √(Σ|b_i|²)`), and more points only lower them. So a covering whose systole
+    /// exceeds `2·√(Σ|b_i|² + 4W)` triangulates every weighted point set (Corollary 9 of
+    /// Caroli–Teillaud: edges below half the systole), and a level of the ladder holds
+    /// once every cell has `ρ + W` below the square of a quarter of its systole (the
+    /// engine's criterion). Equal weights are the unweighted case, with the thesis's 27
+    /// sheets for a cube. CGAL's periodic regular triangulation instead keeps the cube's
+    /// 27 sheets and asks every weight to stay below `c²/64`; here a cube takes 64 sheets
+    /// for any spread below `c²/4`, more sheets beyond, up to [`super::MAX_COPIES`] per
+    /// axis (a spread of about `35c²` for a cube).
+    pub fn for_spread(&self, spread: f64) -> Option<Self> {
+        if spread == 0.0 {
+            return Some(Self::with_ladder(self.lattice.clone(), self.kind));
+        }
+        let need = 2.0 * (self.lattice.one_point_need().powi(2) / 4.0 + 4.0 * spread).sqrt();
+        let ladder = self
+            .lattice
+            .weighted_ladder(self.kind, need * (1.0 + 1e-9))?;
+        Some(FlatTorus {
+            lattice: self.lattice.clone(),
+            ladder,
+            kind: self.kind,
+            spread,
+        })
+    }
+
+    /// The largest spread of weights [`Self::for_spread`] accepts (internal frame).
+    pub fn max_spread(&self) -> f64 {
+        let longest = self.lattice.longest_covering_systole() * (1.0 - 1e-9);
+        ((longest * longest / 4.0 - self.lattice.one_point_need().powi(2) / 4.0) / 4.0).max(0.0)
+    }
+
+    /// The dummy point set: a grid whose cells satisfy the switch criterion with points of
+    /// the least weight while `spread` more is allowed (`r² + W < δ²/16`); none when the
+    /// spread takes more than a quarter of it (a covering is the better start then).
+    pub(super) fn weighted_dummies(&self) -> Vec<[f64; D]> {
+        if self.spread == 0.0 {
+            return self.lattice.dummy_grid();
+        }
+        let d = self.lattice.systole_in();
+        let reduced = d * d - 16.0 * self.spread * (1.0 + 1e-6);
+        if reduced < d * d / 4.0 {
+            return Vec::new();
+        }
+        self.lattice.dummy_grid_for(reduced.sqrt(), 0, 1)
     }
 
     /// The coverings of the ladder, from level 0 (most sheets) to the torus.
@@ -482,6 +544,18 @@ where
         pairs.sort_unstable();
     }
 
+    fn weight_to_internal(&self, w: f64) -> f64 {
+        self.lattice.measure_to_internal(w, 2)
+    }
+
+    fn for_spread(&self, spread: f64) -> Option<Self> {
+        FlatTorus::for_spread(self, spread)
+    }
+
+    fn max_spread(&self) -> f64 {
+        FlatTorus::max_spread(self)
+    }
+
     fn volume(&self) -> f64 {
         self.lattice.volume()
     }
@@ -665,7 +739,7 @@ macro_rules! flat_torus_plugin {
         }
 
         fn dummy_points(&self) -> Vec<Self::Point> {
-            self.lattice.dummy_grid()
+            self.weighted_dummies()
         }
     };
 }

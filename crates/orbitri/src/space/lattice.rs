@@ -224,6 +224,12 @@ impl<const D: usize> Lattice<D> {
         self.unit
     }
 
+    /// A user measure (`power` 1: length, 2: area or weight) in the internal frame: exact,
+    /// or `inf`/`0` where the doubles cannot hold it.
+    pub(crate) fn measure_to_internal(&self, x: f64, power: i32) -> f64 {
+        ldexp(x, (-self.exponent * power).clamp(-2100, 2100))
+    }
+
     /// A user point in the internal frame (exact unless it becomes subnormal there).
     pub(crate) fn to_internal(&self, x: [f64; D]) -> [f64; D] {
         x.map(|v| ldexp(v, -self.exponent))
@@ -465,12 +471,35 @@ impl<const D: usize> Lattice<D> {
     /// torus itself (`Z^D`). [`Ladder::Halving`] falls back to [`Ladder::Grid`] when its
     /// offsets would not fit the 8-bit range.
     pub fn ladder(&self, kind: Ladder) -> Vec<Level<D>> {
+        self.ladder_for(kind, self.one_point_need())
+    }
+
+    /// [`Self::ladder`] whose level 0 has a systole above `need` (internal frame) instead
+    /// of [`Self::one_point_need`] (weighted points ask more). `None` when no covering of at
+    /// most [`MAX_COPIES`] copies per vector is long enough.
+    pub(crate) fn weighted_ladder(&self, kind: Ladder, need: f64) -> Option<Vec<Level<D>>> {
+        let ladder = self.ladder_for(kind, need);
+        (ladder[0].systole > need).then_some(ladder)
+    }
+
+    /// The longest systole a diagonal covering of at most [`MAX_COPIES`] copies per vector
+    /// reaches (internal frame).
+    pub(crate) fn longest_covering_systole(&self) -> f64 {
+        shortest_vector(&self.rows, &diagonal_basis([MAX_COPIES; D]))
+    }
+
+    fn ladder_for(&self, kind: Ladder, need: f64) -> Vec<Level<D>> {
         let identity = Level {
             sub: Sublattice::identity(),
             systole: self.systole,
         };
+        let unweighted = need == self.one_point_need();
         let grid = || {
-            let h = self.covering();
+            let h = if unweighted {
+                self.covering()
+            } else {
+                self.covering_search_for(need).0
+            };
             vec![
                 Level {
                     sub: Sublattice::diagonal(h),
@@ -485,7 +514,6 @@ impl<const D: usize> Lattice<D> {
         if kind == Ladder::Grid || D != 2 {
             return grid();
         }
-        let need = self.one_point_need();
         let mut chain = vec![identity.clone()];
         let mut basis = diagonal_basis([1; D]);
         while chain.last().unwrap().systole <= need {

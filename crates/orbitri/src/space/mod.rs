@@ -212,6 +212,19 @@ pub trait FlatSpace<const D: usize, const N: usize>:
     /// A face given by (vertex, element) pairs in canonical form modulo the group: two
     /// faces that differ by a group element get equal pairs, sorted.
     fn canonical_face(&self, pairs: &mut [(u32, Self::Elem)]);
+    /// A weight (a squared length) of the user in the internal frame: exact, or `inf`/`0`
+    /// where the doubles cannot hold it.
+    fn weight_to_internal(&self, w: f64) -> f64;
+    /// An internal weight in user units (exact).
+    fn weight_to_user(&self, w: f64) -> f64 {
+        self.measure_to_user(w, 2)
+    }
+    /// The space for weighted points whose weights spread over `spread` (largest − least,
+    /// internal frame): coverings and dummy points safe for it. `None` when no covering
+    /// is proven safe ([`FlatSpace::max_spread`] is the limit).
+    fn for_spread(&self, spread: f64) -> Option<Self>;
+    /// The largest spread [`FlatSpace::for_spread`] accepts (internal frame).
+    fn max_spread(&self) -> f64;
     /// The volume (area in 2D) of the space, in user units.
     fn volume(&self) -> f64;
     /// Ok when the space's volume is a normal double in user units (see

@@ -4,7 +4,9 @@
 //! space. `PeriodicDelaunay2` and `PeriodicDelaunay3` name the flat tori, `KleinBottle`
 //! and `FlatManifold3` the other closed flat manifolds.
 
-use std::collections::HashSet;
+mod weighted;
+
+use std::collections::{BTreeMap, HashSet};
 use std::ops::ControlFlow;
 
 use rayon::prelude::*;
@@ -103,7 +105,19 @@ pub struct Triangulation<const D: usize, const N: usize, S: FlatSpace<D, N> = Fl
     used_dummies: bool,
     /// Removals that had to triangulate the remaining points again (see [`Removal`]).
     rebuilds: usize,
+    /// Weighted: each input's weight, in user units (empty when unweighted).
+    input_weight: Vec<f64>,
+    /// Weighted: the hidden inputs (their `input_point` is [`HIDDEN`]), each with its
+    /// wrapped point and weight in the internal frame, to come back when uncovered.
+    hidden: BTreeMap<InputId, ([f64; D], f64)>,
+    /// Weighted: the least and largest internal weight given, and the spread the space's
+    /// coverings are safe for.
+    weight_range: (f64, f64),
+    spread: f64,
 }
+
+/// `input_point` of a hidden input.
+const HIDDEN: PointId = PointId(u32::MAX - 1);
 
 /// The periodic Delaunay triangulation of a flat torus of dimension `D`.
 pub type PeriodicDelaunay<const D: usize, const N: usize> = Triangulation<D, N, FlatTorus<D>>;
@@ -195,6 +209,10 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             duplicates: 0,
             used_dummies: false,
             rebuilds: 0,
+            input_weight: Vec::new(),
+            hidden: BTreeMap::new(),
+            weight_range: (f64::INFINITY, f64::NEG_INFINITY),
+            spread: 0.0,
         }
     }
 
@@ -231,38 +249,56 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         space: S,
         points: &[[f64; D]],
         opts: BuildOptions,
+        progress: impl FnMut(usize) -> ControlFlow<()>,
+    ) -> Result<Self> {
+        Self::build_inner(Self::new(space), points, &[], opts, progress)
+    }
+
+    /// The bulk construction of `points` with `weights` (internal frame, one per point, or
+    /// none when unweighted) into the empty `tri`, whose space and engine are set up.
+    fn build_inner(
+        empty: Self,
+        points: &[[f64; D]],
+        weights: &[f64],
+        opts: BuildOptions,
         mut progress: impl FnMut(usize) -> ControlFlow<()>,
     ) -> Result<Self> {
         if points.is_empty() {
             return Err(Error::EmptyInput);
         }
+        let space = empty.space().clone();
         let (wrapped_pts, wrapped) = internal_points(&space, points)?;
+        let weight = |i: usize| weights.get(i).copied().unwrap_or(0.0);
         let order: Vec<u32> = if opts.spatial_sort {
             spatial_order(&space, &wrapped_pts, opts.seed)
         } else {
             (0..points.len() as u32).collect()
         };
-        let mut tri = Self::new(space.clone());
-        tri.wrapped = wrapped;
+        let fresh = || {
+            let mut tri = empty.emptied();
+            tri.wrapped = wrapped;
+            tri
+        };
+        let mut tri = fresh();
         // a Delaunay triangulation of uniform points has about 6.77 cells per vertex in 3D,
         // exactly 2 in 2D
         let per_point = if D == 3 { 27 } else { 8 };
         tri.engine
             .reserve(points.len() + 128, points.len() * per_point / 4 + 4096);
         if points.len() >= opts.dummy_threshold
-            && tri.build_from_dummies(&wrapped_pts, &order, &mut progress)?
+            && tri.build_from_dummies(&wrapped_pts, weights, &order, &mut progress)?
         {
             tri.represent_first_occurrences(&wrapped_pts);
             return Ok(tri);
         }
-        let mut tri = Self::new(space);
-        tri.wrapped = wrapped;
+        let mut tri = fresh();
         tri.input_point = vec![PointId::NONE; points.len()];
         for (k, &i) in order.iter().enumerate() {
             if k % 4096 == 0 {
                 proceed(&mut progress, k)?;
             }
-            tri.insert_wrapped(InputId(i), wrapped_pts[i as usize]);
+            let i = i as usize;
+            tri.insert_wrapped(InputId::new(i), wrapped_pts[i], weight(i));
         }
         if !tri.engine.is_one_sheeted() {
             tri.engine.try_one_sheet();
@@ -302,11 +338,19 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     fn build_from_dummies(
         &mut self,
         pts: &[[f64; D]],
+        weights: &[f64],
         order: &[u32],
         progress: &mut impl FnMut(usize) -> ControlFlow<()>,
     ) -> Result<bool> {
         let dummies = self.engine.space().dummy_points();
+        if dummies.is_empty() {
+            return Ok(false);
+        }
         let k = dummies.len() as u32;
+        if self.engine.is_weighted() {
+            // the least weight: a dummy hides no point unless one lies on it
+            self.engine.weights = vec![self.weight_range.0; dummies.len()];
+        }
         self.engine.points = dummies;
         self.engine.bootstrap_one_sheeted();
         self.input_point = vec![PointId::NONE; pts.len()];
@@ -316,13 +360,19 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             if n % 4096 == 0 {
                 proceed(progress, n)?;
             }
-            match self.engine.insert(pts[i as usize]) {
+            let w = weights.get(i as usize).copied().unwrap_or(0.0);
+            match self.engine.insert_weighted(pts[i as usize], w) {
                 Inserted::New(p) => {
-                    self.input_point[i as usize] = p;
-                    self.point_input.push(InputId(i));
+                    // a dummy hidden by a point on it (of a larger weight): start again
+                    // without
+                    if self.engine.hidden_log.iter().any(|h| h.id.0 < k) {
+                        return Ok(false);
+                    }
+                    self.record_new(InputId(i), p);
                 }
                 Inserted::Duplicate(p) if p.0 < k => return Ok(false),
                 Inserted::Duplicate(p) => self.record_duplicate(InputId(i), p),
+                Inserted::Hidden => self.record_hidden(InputId(i), pts[i as usize], w),
             }
         }
         // 1-sheeted: the vertex of dummy point `d` has its id
@@ -340,20 +390,31 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             *p = PointId(p.0 - k);
         }
         self.used_dummies = true;
+        // points hidden with the dummies' help come back
+        self.uncover();
         proceed(progress, pts.len())?;
         Ok(true)
     }
 
-    fn insert_wrapped(&mut self, i: InputId, p: [f64; D]) -> Inserted {
-        let r = self.engine.insert(p);
+    /// Inserts input `i` at the internal point `p` of internal weight `w` (ignored when
+    /// unweighted).
+    fn insert_wrapped(&mut self, i: InputId, p: [f64; D], w: f64) -> Inserted {
+        let r = self.engine.insert_weighted(p, w);
         match r {
-            Inserted::New(v) => {
-                self.input_point[i.index()] = v;
-                self.point_input.push(i);
-            }
+            Inserted::New(v) => self.record_new(i, v),
             Inserted::Duplicate(v) => self.record_duplicate(i, v),
+            Inserted::Hidden => self.record_hidden(i, p, w),
         }
         r
+    }
+
+    /// Input `i` became point `p`, after the points it hid left (each renumbering the last
+    /// point, first of all the new one, into its id: followed here in the same order).
+    fn record_new(&mut self, i: InputId, p: PointId) {
+        self.input_point[i.index()] = PointId::new(self.point_input.len());
+        self.point_input.push(i);
+        self.absorb_hidden();
+        debug_assert_eq!(self.input_point[i.index()], p);
     }
 
     /// Input `i` coincides with point `p`; the point keeps the smallest input id.
@@ -366,13 +427,10 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
 
     /// Inserts one more point (wrapped into the domain); its input id is the number of
     /// points given so far. Returns the point (vertex of the quotient) it became or
-    /// coincides with.
+    /// coincides with. (In a weighted triangulation its weight is 0: see
+    /// [`Self::insert_weighted`].)
     pub fn insert(&mut self, p: [f64; D]) -> Result<Inserted> {
-        let i = self.input_point.len();
-        let (w, moved) = internal_point(self.space(), i, &p)?;
-        self.wrapped += moved as usize;
-        self.input_point.push(PointId::NONE);
-        Ok(self.insert_wrapped(InputId::new(i), w))
+        self.insert_weighted(p, 0.0)
     }
 
     /// Inserts a batch of points, all or nothing: every point is checked and wrapped first,
@@ -383,25 +441,45 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     /// `points`, and a point met several times keeps the coordinates of its first
     /// occurrence, as in [`Self::build`]. Returns, per point, the point (vertex of the
     /// quotient) it became or coincides with.
+    ///
+    /// (In a weighted triangulation their weights are 0: see
+    /// [`Self::insert_all_weighted`].)
     pub fn insert_all(&mut self, points: &[[f64; D]]) -> Result<Vec<Inserted>> {
-        let (internal, moved) = internal_points(self.space(), points)?;
+        self.insert_all_weighted(points, &[])
+    }
+
+    /// [`Self::insert_all`] of checked internal points and weights (internal frame; none
+    /// when unweighted).
+    fn insert_all_internal(&mut self, internal: &[[f64; D]], weights: &[f64]) -> Vec<Inserted> {
         let first = self.input_point.len();
-        self.input_point.resize(first + points.len(), PointId::NONE);
-        self.wrapped += moved;
+        self.input_point
+            .resize(first + internal.len(), PointId::NONE);
         let seed = BuildOptions::default().seed ^ first as u64;
-        let mut out = vec![Inserted::New(PointId(0)); points.len()];
-        for k in spatial_order(self.space(), &internal, seed) {
-            let i = InputId::new(first + k as usize);
-            out[k as usize] = self.insert_wrapped(i, internal[k as usize]);
+        let mut out = vec![Inserted::New(PointId(0)); internal.len()];
+        for k in spatial_order(self.space(), internal, seed) {
+            let k = k as usize;
+            let i = InputId::new(first + k);
+            let w = weights.get(k).copied().unwrap_or(0.0);
+            out[k] = self.insert_wrapped(i, internal[k], w);
         }
-        // a duplicate inserted before its first occurrence lent the point its coordinates
-        for (k, r) in out.iter().enumerate() {
-            let (Inserted::New(p) | Inserted::Duplicate(p)) = *r;
+        // a duplicate inserted before its first occurrence lent the point its coordinates;
+        // (hidden points, and points a later one hid, have no point)
+        for (k, r) in out.iter_mut().enumerate() {
+            let p = self.input_point[first + k];
+            if p == HIDDEN {
+                *r = Inserted::Hidden;
+                continue;
+            }
             if self.point_input[p.index()].index() == first + k {
                 self.represent(p, internal[k]);
             }
+            // (ids as they are now: a later point may have hidden one before)
+            *r = match *r {
+                Inserted::Duplicate(_) => Inserted::Duplicate(p),
+                _ => Inserted::New(p),
+            };
         }
-        Ok(out)
+        out
     }
 
     /// Removes input point `i`: afterwards the triangulation is the Delaunay triangulation
@@ -430,12 +508,17 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     pub fn remove(&mut self, i: InputId) -> Result<Removal> {
         let p = self.live_point(i)?;
         self.input_point[i.index()] = PointId::NONE;
+        if p == HIDDEN {
+            self.hidden.remove(&i);
+            return Ok(Removal::InPlace);
+        }
         if self.detach_duplicate(i, p) {
             return Ok(Removal::InPlace);
         }
         let how = self.engine.remove_point(p);
         self.rebuilds += (how == Removal::Rebuilt) as usize;
         self.forget_point(p);
+        self.uncover();
         Ok(how)
     }
 
@@ -466,7 +549,9 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         for &i in ids {
             let p = self.input_point[i.index()];
             self.input_point[i.index()] = PointId::NONE;
-            if !self.detach_duplicate(i, p) {
+            if p == HIDDEN {
+                self.hidden.remove(&i);
+            } else if !self.detach_duplicate(i, p) {
                 gone.push(p);
             }
         }
@@ -474,7 +559,11 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             return Ok(Removal::InPlace);
         }
         let (map, rebuilt) = self.engine.remove_points(&gone);
-        for p in self.input_point.iter_mut().filter(|p| **p != PointId::NONE) {
+        for p in self
+            .input_point
+            .iter_mut()
+            .filter(|p| **p != PointId::NONE && **p != HIDDEN)
+        {
             *p = map[p.index()];
         }
         let mut k = 0;
@@ -483,6 +572,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             map[k - 1] != PointId::NONE
         });
         self.rebuilds += rebuilt as usize;
+        self.uncover();
         Ok(if rebuilt {
             Removal::Rebuilt
         } else {
@@ -511,7 +601,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
                 .iter()
                 .enumerate()
                 .any(|(j, &x)| x == p && j != i.index());
-        if !shared {
+        if !shared && !self.engine.is_weighted() {
             match self.engine.move_point(p, w) {
                 Moved::Coordinates => return true,
                 Moved::Reinserted => return false,
@@ -528,8 +618,9 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
                 Moved::Refused => {}
             }
         }
+        let weight = self.internal_weight(i);
         self.remove(i).expect("a live input");
-        if let Inserted::Duplicate(q) = self.insert_wrapped(i, w) {
+        if let Inserted::Duplicate(q) = self.insert_wrapped(i, w, weight) {
             self.represent_if_first(q, i, w);
         }
         false
@@ -707,12 +798,16 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     /// The position of input point `i`'s image under the group element `offset` (in a
     /// torus, `points[i] + offset·M`), in Cartesian coordinates.
     pub fn position(&self, i: InputId, offset: S::Elem) -> [f64; D] {
-        let p = self.engine.points()[self.vertex_of_input(i).index()];
+        let p = match self.hidden.get(&i) {
+            Some(&(x, _)) => x,
+            None => self.engine.points()[self.vertex_of_input(i).index()],
+        };
         let space = self.space();
         space.to_user(space.lifted_position((p, offset)))
     }
 
-    /// The point (vertex of the quotient) of input point `i`.
+    /// The point (vertex of the quotient) of input point `i` ([`PointId::NONE`] once
+    /// removed, `PointId(u32::MAX - 1)` while hidden).
     pub fn vertex_of_input(&self, i: InputId) -> PointId {
         self.input_point[i.index()]
     }
@@ -723,16 +818,15 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     }
 
     /// For every input point, the input id of its first occurrence (itself unless
-    /// duplicate; [`InputId::NONE`] once removed).
+    /// duplicate, or hidden; [`InputId::NONE`] once removed).
     pub fn first_occurrences(&self) -> Vec<InputId> {
         self.input_point
             .iter()
-            .map(|&v| {
-                if v == PointId::NONE {
-                    InputId::NONE
-                } else {
-                    self.point_input[v.index()]
-                }
+            .enumerate()
+            .map(|(i, &v)| match v {
+                PointId::NONE => InputId::NONE,
+                HIDDEN => InputId::new(i),
+                _ => self.point_input[v.index()],
             })
             .collect()
     }
@@ -902,6 +996,9 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     /// The neighbours of input point `i`: (input id, offset of the neighbour relative to
     /// the point), one entry per Delaunay edge at the point, from the point's star.
     pub fn vertex_neighbors(&self, i: InputId) -> Vec<(InputId, S::Elem)> {
+        if self.hidden.contains_key(&i) {
+            return Vec::new();
+        }
         let v = self.engine.vertex_of_point(self.vertex_of_input(i));
         let mut out: Vec<(InputId, S::Elem)> = self
             .engine
