@@ -1,4 +1,6 @@
-//! Periodic Voronoi cells, the duals of the Delaunay triangulation: for every point, its cell
+//! Periodic Voronoi cells, the duals of the Delaunay triangulation (power, or Laguerre,
+//! cells of the regular triangulation for weighted points: orthocenters for circumcenters,
+//! hidden points with empty cells): for every point, its cell
 //! around the point (vertices = circumcenters of the cells of its star, faces = duals of its
 //! Delaunay edges, each with the neighbour's id and lattice shift), volume (area in 2D), face
 //! areas (lengths in 2D) and centroid. Computed from the triangulation's adjacency and the
@@ -134,12 +136,15 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     /// It computes the circumcenters and cospherical classes of the whole triangulation
     /// first: for many cells, call [`Self::voronoi_cells`] once.
     pub fn voronoi_cell(&self, i: InputId) -> VoronoiCell<D, S::Elem> {
+        if self.is_hidden(i) {
+            return self.hidden_cell(i);
+        }
         let duals = self.duals(&|| false).expect("never interrupted");
         self.cell_of_point(&duals, self.vertex_of_input(i))
     }
 
     /// The Voronoi cells of the distinct points, in the order of their first occurrence
-    /// (computed in parallel).
+    /// (computed in parallel); weighted, the power cells, hidden inputs' (empty) included.
     pub fn voronoi_cells(&self) -> Vec<VoronoiCell<D, S::Elem>> {
         self.per_cell(|c| c)
     }
@@ -208,12 +213,33 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
                 Ok(Some(f(self.cell_of_point(&duals, PointId(p)))))
             })
             .collect::<Result<_>>()?;
-        let mut order: Vec<PointId> = (0..out.len() as u32).map(PointId).collect();
-        order.sort_unstable_by_key(|&p| self.input_of_vertex(p));
+        // the points, then the hidden inputs (empty cells), by input id
+        let mut order: Vec<(InputId, PointId)> = (0..out.len() as u32)
+            .map(|p| (self.input_of_vertex(PointId(p)), PointId(p)))
+            .chain(self.hidden().into_iter().map(|i| (i, PointId::NONE)))
+            .collect();
+        order.sort_unstable();
         Ok(order
             .iter()
-            .map(|&p| out[p.index()].take().expect("each point once"))
+            .map(|&(i, p)| match p {
+                PointId::NONE => f(self.hidden_cell(i)),
+                p => out[p.index()].take().expect("each point once"),
+            })
             .collect())
+    }
+
+    /// The empty power cell of hidden input `i`: no vertices or faces, volume 0, its
+    /// centroid at the point.
+    fn hidden_cell(&self, i: InputId) -> VoronoiCell<D, S::Elem> {
+        let position = self.position(i, self.space().identity());
+        VoronoiCell {
+            point: i,
+            position,
+            vertices: Vec::new(),
+            faces: Vec::new(),
+            volume: 0.0,
+            centroid: position,
+        }
     }
 
     /// The Voronoi neighbour pairs with their shared face areas, each unordered pair of
@@ -245,7 +271,12 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
                 if k % 1024 == 0 && interrupt() {
                     return Err(Error::Interrupted);
                 }
-                Ok(space.circumcenter(&e.lifted_cell(c)))
+                let lifted = e.lifted_cell(c);
+                Ok(if e.is_weighted() {
+                    space.orthocenter(&lifted, &e.cell_weights(c))
+                } else {
+                    space.circumcenter(&lifted)
+                })
             })
             .collect::<Result<_>>()?;
         let mut center = vec![[0.0; D]; slots];
@@ -275,7 +306,13 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
                         e.points()[e.point_of(dc.v[y]).index()],
                         space.compose(shift, dc.off[y]),
                     );
-                    space.cospherical(&lifted, opposite).then_some((c, x, d, y))
+                    let same = if e.is_weighted() {
+                        let w = e.vertex_weight(dc.v[y]);
+                        space.orthogonal(&lifted, &e.cell_weights(c), opposite, w)
+                    } else {
+                        space.cospherical(&lifted, opposite)
+                    };
+                    same.then_some((c, x, d, y))
                 })
             })
             .collect();
@@ -387,6 +424,11 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             let pts: Vec<&[f64]> = ids.iter().map(|&i| &vertices[i as usize][..]).collect();
             let area = if D == 2 {
                 let d: Vec<f64> = (0..2).map(|x| pts[1][x] - pts[0][x]).collect();
+                // counter-clockwise around the cell: the outward normal (d_y, −d_x) points
+                // to the neighbour
+                if d[1] * dir[0] - d[0] * dir[1] < 0.0 {
+                    ids.reverse();
+                }
                 dot(&d, &d).sqrt()
             } else {
                 let n = newell(&pts);
@@ -465,7 +507,8 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
 
 /// Volume and centroid (relative to the point) of a cell whose vertices are relative to the
 /// point: in 3D the sum of the tetrahedra from the point to each face's fan triangles, in
-/// 2D of the triangles from the point to each edge (signed by the orientation).
+/// 2D of the triangles from the point to each edge, signed by the faces' outward
+/// orientation (a power cell may leave its point outside).
 fn measure<const D: usize, E>(
     vertices: &[[f64; D]],
     faces: &[VoronoiFace<D, E>],
@@ -475,9 +518,9 @@ fn measure<const D: usize, E>(
     for f in faces {
         let v: Vec<&[f64; D]> = f.vertices.iter().map(|&i| &vertices[i as usize]).collect();
         if D == 2 {
-            // orientation from the bisector side: the point (origin) and the neighbour are
-            // on opposite sides, so |cross| is the triangle's doubled area
-            let a = (v[0][0] * v[1][1] - v[0][1] * v[1][0]).abs() / 2.0;
+            // the edge runs counter-clockwise: the signed triangles from the point sum to
+            // the area even when the point lies outside its cell (a power cell)
+            let a = (v[0][0] * v[1][1] - v[0][1] * v[1][0]) / 2.0;
             vol += a;
             for c in 0..D {
                 acc[c] += a * (v[0][c] + v[1][c]) / 3.0;

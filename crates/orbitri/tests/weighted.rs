@@ -364,3 +364,65 @@ fn wide_spreads_take_larger_coverings() {
     all_w.push(0.02);
     check(&tri, &all_p, &all_w);
 }
+
+/// Power cells: volumes sum to the domain's, hidden inputs get empty cells, and each
+/// cell's volume agrees with an independent estimate (the share of sample points whose
+/// least power distance goes to its point); equal weights give the Voronoi cells.
+#[test]
+fn laguerre_cells() {
+    for (n, wmax) in [(40usize, 0.01), (2000, 0.002)] {
+        let (pts, w) = random::<3>(n, 17, 1.0, wmax);
+        let space = FlatTorus::cuboid([1.0; 3]).unwrap();
+        let tri = PeriodicDelaunay3::build_weighted(space.clone(), &pts, &w).unwrap();
+        let cells = tri.voronoi_cells();
+        assert_eq!(cells.len(), n - tri.duplicates());
+        let total: f64 = cells.iter().map(|c| c.volume).sum();
+        assert!((total - 1.0).abs() < 1e-12, "{total}");
+        for c in &cells {
+            assert_eq!(c.volume == 0.0, tri.is_hidden(c.point), "{:?}", c.point);
+            assert!(c.volume >= 0.0);
+        }
+        // sampled shares: each sample goes to the least power distance over nearby copies
+        let mut r = SplitMix::new(4);
+        let samples = 20_000;
+        let mut count = vec![0usize; n];
+        for _ in 0..samples {
+            let x: [f64; 3] = std::array::from_fn(|_| r.unit());
+            let mut best = (f64::INFINITY, 0);
+            for (j, p) in pts.iter().enumerate() {
+                let d2: f64 = (0..3)
+                    .map(|c| {
+                        let t = (x[c] - p[c]).rem_euclid(1.0);
+                        t.min(1.0 - t).powi(2)
+                    })
+                    .sum();
+                if d2 - w[j] < best.0 {
+                    best = (d2 - w[j], j);
+                }
+            }
+            count[best.1] += 1;
+        }
+        for c in &cells {
+            let share = count[c.point.index()] as f64 / samples as f64;
+            let sigma = (c.volume * (1.0 - c.volume) / samples as f64).sqrt();
+            assert!(
+                (share - c.volume).abs() < 6.0 * sigma + 1e-4,
+                "{:?}: sampled {share} vs {}",
+                c.point,
+                c.volume
+            );
+        }
+        let plain = PeriodicDelaunay3::build(space.clone(), &pts).unwrap();
+        let same = PeriodicDelaunay3::build_weighted(space, &pts, &vec![0.5; n]).unwrap();
+        for (a, b) in plain.voronoi_cells().iter().zip(same.voronoi_cells()) {
+            assert!((a.volume - b.volume).abs() < 1e-14);
+        }
+    }
+    // 2D: areas sum to the box's
+    let (pts, w) = random::<2>(500, 2, 1.0, 0.004);
+    let tri =
+        PeriodicDelaunay2::build_weighted(FlatTorus::cuboid([1.0, 1.0]).unwrap(), &pts, &w).unwrap();
+    let total: f64 = tri.voronoi_cells().iter().map(|c| c.volume).sum();
+    assert!((total - 1.0).abs() < 1e-12, "{total}");
+    assert!(!tri.hidden().is_empty());
+}
