@@ -43,6 +43,8 @@ enum Command {
         #[command(flatten)]
         domain: Domain,
         #[command(flatten)]
+        weighting: Weighting,
+        #[command(flatten)]
         out: Output,
     },
     /// Compute the periodic Voronoi cell of every point of INPUT.
@@ -59,6 +61,8 @@ enum Command {
         input: PathBuf,
         #[command(flatten)]
         domain: Domain,
+        #[command(flatten)]
+        weighting: Weighting,
         /// Output file (default: the CSV table on standard output); its extension, .csv,
         /// .npy, .npz, .json or .vtu, picks the format, unless --format is given
         #[arg(short = 'o', long)]
@@ -210,6 +214,45 @@ impl From<Domain2> for Domain {
             },
         }
     }
+}
+
+/// Weighted points: `--weights` or `--radii` (the power, or Laguerre, diagram).
+#[derive(Args)]
+#[group(multiple = false)]
+struct Weighting {
+    /// Each input row has one more number, the point's weight (a squared length): the
+    /// regular triangulation and its power (Laguerre) cells; a point whose power cell is
+    /// empty is hidden (no vertex, volume 0)
+    #[arg(long)]
+    weights: bool,
+    /// Each input row has one more number, the point's radius r ≥ 0 (weight r²)
+    #[arg(long)]
+    radii: bool,
+}
+
+impl Weighting {
+    fn column(&self) -> Option<orbitri::io::WeightColumn> {
+        use orbitri::io::WeightColumn;
+        match (self.weights, self.radii) {
+            (true, _) => Some(WeightColumn::Weight),
+            (_, true) => Some(WeightColumn::Radius),
+            _ => None,
+        }
+    }
+}
+
+/// The points of `input`, and their weights when `weighting` asks for them.
+fn read_input<const D: usize>(
+    input: &Path,
+    weighting: &Weighting,
+) -> Result<(Vec<[f64; D]>, Option<Vec<f64>>), CliError> {
+    Ok(match weighting.column() {
+        Some(column) => {
+            let (p, w) = orbitri::io::read_weighted_points(input, column)?;
+            (p, Some(w))
+        }
+        None => (orbitri::io::read_points(input)?, None),
+    })
 }
 
 #[derive(Args)]
@@ -398,15 +441,21 @@ struct Cost {
 fn build<const D: usize, const N: usize, S: FlatSpace<D, N>>(
     space: S,
     pts: &[[f64; D]],
+    weights: Option<&[f64]>,
 ) -> Result<(Triangulation<D, N, S>, Cost), orbitri::Error> {
     let bar = progress_bar(pts.len(), pts.len(), "triangulation");
     let start = Instant::now();
-    let tri = Triangulation::build_with(space, pts, BuildOptions::default(), |k| {
+    let progress = |k: usize| {
         if let Some(b) = &bar {
             b.set_position(k as u64);
         }
         std::ops::ControlFlow::Continue(())
-    })?;
+    };
+    let opts = BuildOptions::default();
+    let tri = match weights {
+        Some(w) => Triangulation::build_weighted_with(space, pts, w, opts, progress)?,
+        None => Triangulation::build_with(space, pts, opts, progress)?,
+    };
     let cost = Cost {
         seconds: start.elapsed().as_secs_f64(),
         peak_rss_kb: rss::peak_kb(),
@@ -422,8 +471,13 @@ fn stats_line<const D: usize, const N: usize, S: FlatSpace<D, N>>(
     input: usize,
     cost: &Cost,
 ) -> String {
+    let hidden = if tri.is_weighted() {
+        format!(" hidden={}", tri.hidden().len())
+    } else {
+        String::new()
+    };
     format!(
-        "input={input} vertices={} cells={} sheets={} duplicates={} wrapped={} dummies={} build_seconds={:.6} peak_rss_kb={}",
+        "input={input} vertices={} cells={} sheets={} duplicates={}{hidden} wrapped={} dummies={} build_seconds={:.6} peak_rss_kb={}",
         tri.number_of_vertices(),
         tri.number_of_cells(),
         tri.sheets(),
@@ -447,8 +501,13 @@ fn writer(path: &Option<PathBuf>) -> Result<Box<dyn Write>, CliError> {
     })
 }
 
-fn triangulate(input: PathBuf, domain: Domain, out: Output) -> Result<(), CliError> {
-    with_space!(space(&domain)?, triangulate_in(&input, out))
+fn triangulate(
+    input: PathBuf,
+    domain: Domain,
+    weighting: Weighting,
+    out: Output,
+) -> Result<(), CliError> {
+    with_space!(space(&domain)?, triangulate_in(&input, &weighting, out))
 }
 
 /// The format of an output: `--format` if given, else the one its extension names (its
@@ -492,6 +551,7 @@ fn output_format<F: ValueEnum + Copy>(
 fn triangulate_in<const D: usize, const N: usize, S: SpaceFormat<D, N>>(
     space: S,
     input: &Path,
+    weighting: &Weighting,
     out: Output,
 ) -> Result<(), CliError> {
     let format = output_format(
@@ -500,8 +560,8 @@ fn triangulate_in<const D: usize, const N: usize, S: SpaceFormat<D, N>>(
         &[("txt", Format::Cells)],
         Format::Cells,
     )?;
-    let pts: Vec<[f64; D]> = orbitri::io::read_points(input)?;
-    let (tri, cost) = build(space, &pts)?;
+    let (pts, weights) = read_input::<D>(input, weighting)?;
+    let (tri, cost) = build(space, &pts, weights.as_deref())?;
     write_with(&out.output, |w| match format {
         Format::Cells => orbitri::io::write_cells(w, &tri),
         Format::Json => orbitri::io::write_json(w, &tri),
@@ -515,6 +575,7 @@ fn triangulate_in<const D: usize, const N: usize, S: SpaceFormat<D, N>>(
 
 /// Options of `orbitri voronoi`.
 struct VoronoiArgs {
+    weighting: Weighting,
     output: Option<PathBuf>,
     format: Option<VoronoiFormat>,
     neighbours: Option<PathBuf>,
@@ -545,8 +606,8 @@ fn voronoi_in<const D: usize, const N: usize, S: SpaceFormat<D, N>>(
 ) -> Result<(), CliError> {
     space.check_volume_representable()?;
     let format = output_format(args.format, &args.output, &[], VoronoiFormat::Csv)?;
-    let pts: Vec<[f64; D]> = orbitri::io::read_points(input)?;
-    let (tri, cost) = build(space, &pts)?;
+    let (pts, weights) = read_input::<D>(input, &args.weighting)?;
+    let (tri, cost) = build(space, &pts, weights.as_deref())?;
     // whole cells only when an output needs their geometry; tables need their measures
     let whole =
         matches!(format, VoronoiFormat::Json | VoronoiFormat::Vtu) || args.neighbours.is_some();
@@ -628,7 +689,7 @@ fn draw_in<S: Drawable>(
 ) -> Result<(), CliError> {
     let pts: Vec<[f64; 2]> = orbitri::io::read_points(input)?;
     opts.validate(pts.len()).map_err(option_error)?;
-    let (tri, _) = build(space, &pts)?;
+    let (tri, _) = build(space, &pts, None)?;
     let mut svg = Vec::new();
     orbitri::io::write_svg(&mut svg, &tri, &opts).map_err(|e| {
         // writing to memory fails only on options out of range (a picture too high)
@@ -701,7 +762,7 @@ fn demo(n: usize, seed: u64) -> Result<(), CliError> {
         let _ = writeln!(out, "{s}");
     };
     let pts = uniform::<3>(n, seed);
-    let (tri, cost) = build::<3, 4, _>(FlatTorus3::cuboid([1.0; 3])?, &pts)?;
+    let (tri, cost) = build::<3, 4, _>(FlatTorus3::cuboid([1.0; 3])?, &pts, None)?;
     say(
         &mut out,
         format!("uniform random points in the unit cube (seed {seed}):"),
@@ -744,7 +805,7 @@ fn demo(n: usize, seed: u64) -> Result<(), CliError> {
             }
         }
     }
-    let (tri, cost) = build::<3, 4, _>(FlatTorus3::cuboid([0.6; 3])?, &fcc)?;
+    let (tri, cost) = build::<3, 4, _>(FlatTorus3::cuboid([0.6; 3])?, &fcc, None)?;
     say(
         &mut out,
         "FCC crystal, 864 points, all octahedral holes cospherical:".to_string(),
@@ -763,7 +824,8 @@ fn demo(n: usize, seed: u64) -> Result<(), CliError> {
     );
     // 2D: the same engine on the unit square, then a honeycomb (6 cocircular points around
     // every hexagon) in its hexagonal cell
-    let (tri, cost) = build::<2, 3, _>(FlatTorus2::cuboid([1.0; 2])?, &uniform::<2>(n, seed))?;
+    let (tri, cost) =
+        build::<2, 3, _>(FlatTorus2::cuboid([1.0; 2])?, &uniform::<2>(n, seed), None)?;
     say(
         &mut out,
         format!("uniform random points in the unit square (seed {seed}):"),
@@ -781,7 +843,7 @@ fn demo(n: usize, seed: u64) -> Result<(), CliError> {
             }
         }
     }
-    let (tri, cost) = build::<2, 3, _>(hex, &honey)?;
+    let (tri, cost) = build::<2, 3, _>(hex, &honey, None)?;
     say(
         &mut out,
         "honeycomb, 800 points in a hexagonal cell, 6 cocircular points per hexagon:".to_string(),
@@ -864,11 +926,17 @@ fn number(s: &str) -> Result<f64, String> {
 fn main() -> ExitCode {
     let cli = Cli::parse_from(mark_negative_numbers(std::env::args_os()));
     let result = match cli.command {
-        Command::Triangulate { input, domain, out } => triangulate(input, domain, out),
+        Command::Triangulate {
+            input,
+            domain,
+            weighting,
+            out,
+        } => triangulate(input, domain, weighting, out),
         Command::Demo { points, seed } => demo(points, seed),
         Command::Voronoi {
             input,
             domain,
+            weighting,
             output,
             format,
             neighbours,
@@ -878,6 +946,7 @@ fn main() -> ExitCode {
             input,
             domain,
             VoronoiArgs {
+                weighting,
                 output,
                 format,
                 neighbours,

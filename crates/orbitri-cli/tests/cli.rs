@@ -1152,3 +1152,83 @@ fn draw_help_is_two_dimensional_and_generate_is_documented() {
         assert!(help.contains(doc), "{doc}: {help}");
     }
 }
+
+/// `--weights` and `--radii`: the hidden column, `hidden=` in the statistics, JSON weights
+/// and hidden ids, and a negative radius named by its row.
+#[test]
+fn weighted_points_on_the_command_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("w.txt");
+    // point 3 sits next to point 1, whose weight covers it
+    std::fs::write(
+        &input,
+        "0.1 0.1 0.1 0\n0.6 0.2 0.3 0.04\n0.3 0.7 0.5 0\n0.62 0.21 0.3 0\n0.8 0.8 0.9 0\n",
+    )
+    .unwrap();
+    let csv = dir.path().join("cells.csv");
+    let out = orbitri(&[
+        "voronoi",
+        input.to_str().unwrap(),
+        "--box",
+        "1",
+        "1",
+        "1",
+        "--weights",
+        "--stats",
+        "-o",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(String::from_utf8_lossy(&out.stderr).contains("hidden=1"));
+    let table = std::fs::read_to_string(&csv).unwrap();
+    let header: Vec<&str> = table.lines().next().unwrap().split(',').collect();
+    let k = header.iter().position(|c| *c == "hidden").unwrap();
+    let hidden: Vec<&str> = table
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(k).unwrap())
+        .collect();
+    assert_eq!(hidden, ["0", "0", "0", "1", "0"]);
+    let vol: f64 = table
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(1).unwrap().parse::<f64>().unwrap())
+        .sum();
+    assert!((vol - 1.0).abs() < 1e-12);
+    let json = dir.path().join("t.json");
+    let out = orbitri(&[
+        "triangulate",
+        input.to_str().unwrap(),
+        "--box",
+        "1",
+        "1",
+        "1",
+        "--radii",
+        "-o",
+        json.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(&json).unwrap();
+    assert!(text.contains("\"weights\":[0.0,0.0016"), "{text}");
+    std::fs::write(&input, "0.1 0.1 0.1 0\n0.6 0.2 0.3 -0.5\n").unwrap();
+    let out = orbitri(&[
+        "triangulate",
+        input.to_str().unwrap(),
+        "--box",
+        "1",
+        "1",
+        "1",
+        "--radii",
+    ]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("point 1: radius -0.5"), "{err}");
+}

@@ -420,8 +420,8 @@ fn laguerre_cells() {
     }
     // 2D: areas sum to the box's
     let (pts, w) = random::<2>(500, 2, 1.0, 0.004);
-    let tri =
-        PeriodicDelaunay2::build_weighted(FlatTorus::cuboid([1.0, 1.0]).unwrap(), &pts, &w).unwrap();
+    let tri = PeriodicDelaunay2::build_weighted(FlatTorus::cuboid([1.0, 1.0]).unwrap(), &pts, &w)
+        .unwrap();
     let total: f64 = tri.voronoi_cells().iter().map(|c| c.volume).sum();
     assert!((total - 1.0).abs() < 1e-12, "{total}");
     assert!(!tri.hidden().is_empty());

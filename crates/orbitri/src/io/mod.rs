@@ -26,7 +26,7 @@ pub use write::{write_cells, write_json};
 
 use std::path::Path;
 
-use crate::error::Result;
+use crate::error::{Error, Result};
 
 /// Reads `D`-dimensional points from a text file or, for a `.npy` name, an array of shape
 /// `(N, D)` (float64, float32 or integers).
@@ -39,4 +39,43 @@ pub fn read_points<const D: usize>(path: &Path) -> Result<Vec<[f64; D]>> {
     } else {
         read_text(path)
     }
+}
+
+/// What the extra last column of weighted points holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum WeightColumn {
+    /// The weight itself (a squared length).
+    Weight,
+    /// A radius `r ≥ 0`: the weight is `r²`.
+    Radius,
+}
+
+/// Reads `D`-dimensional points with one more number per row (as [`read_points`]), a
+/// weight or a radius, and returns the points and their weights. A radius that is negative
+/// or not finite is an error naming its row.
+pub fn read_weighted_points<const D: usize>(
+    path: &Path,
+    column: WeightColumn,
+) -> Result<(Vec<[f64; D]>, Vec<f64>)> {
+    let rows: Vec<Vec<f64>> = match D {
+        2 => read_points::<3>(path)?.iter().map(|r| r.to_vec()).collect(),
+        3 => read_points::<4>(path)?.iter().map(|r| r.to_vec()).collect(),
+        _ => unreachable!("points are 2D or 3D"),
+    };
+    let points = rows.iter().map(|r| std::array::from_fn(|c| r[c])).collect();
+    let weights = rows
+        .iter()
+        .enumerate()
+        .map(|(i, r)| match column {
+            WeightColumn::Weight => Ok(r[D]),
+            WeightColumn::Radius if r[D].is_finite() && r[D] >= 0.0 => Ok(r[D] * r[D]),
+            WeightColumn::Radius => Err(Error::BadWeight {
+                index: i,
+                what: "radius",
+                value: r[D],
+                why: format!("in {} is not a finite number ≥ 0", path.display()),
+            }),
+        })
+        .collect::<Result<_>>()?;
+    Ok((points, weights))
 }

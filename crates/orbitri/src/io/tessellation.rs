@@ -18,8 +18,9 @@ use crate::Copies;
 const AXES: [&str; 3] = ["x", "y", "z"];
 
 /// The per-point table, one row per *input* point in input order: its cell's volume (area in
-/// 2D), number of faces, surface area (perimeter in 2D), centroid, and the input id of the
-/// first occurrence for a duplicate (which shares that cell), else `-1`.
+/// 2D), number of faces, surface area (perimeter in 2D), centroid, for weighted points
+/// whether it is hidden (1: its power cell is empty), and the input id of the first
+/// occurrence for a duplicate (which shares that cell), else `-1`.
 pub struct PointTable {
     pub columns: Vec<String>,
     pub rows: Vec<Vec<f64>>,
@@ -37,12 +38,19 @@ pub fn point_table<const D: usize, const N: usize, S: FlatSpace<D, N>>(
         .map(|s| s.to_string())
         .collect();
     columns.extend((0..D).map(|k| format!("centroid_{}", AXES[k])));
+    let weighted = tri.is_weighted();
+    if weighted {
+        columns.push("hidden".into());
+    }
     columns.push("duplicate_of".into());
     let rows = (0..tri.number_of_input_points())
         .map(|i| {
             let c = by_point[&first[i]];
             let mut row = vec![i as f64, c.volume, c.faces as f64, c.surface_area];
             row.extend_from_slice(&c.centroid);
+            if weighted {
+                row.push(f64::from(u8::from(tri.is_hidden(InputId::new(i)))));
+            }
             row.push(if first[i].index() == i {
                 -1.0
             } else {
@@ -69,6 +77,7 @@ impl PointTable {
                 }
                 match k {
                     0 | 2 => write!(line, "{}", *v as u64),
+                    _ if self.columns[k] == "hidden" => write!(line, "{}", *v as u64),
                     _ if k == last => match *v < 0.0 {
                         true => Ok(()),
                         false => write!(line, "{}", *v as u64),
@@ -97,21 +106,30 @@ impl PointTable {
         let ints = |k: usize| NpyData::I64(column(k).map(|v| v as i64).collect());
         let floats = |k: usize| NpyData::F64(column(k).collect());
         let last = self.columns.len() - 1;
-        let dim = last - 4;
-        let centroid = self.rows.iter().flat_map(|r| r[4..last].to_vec()).collect();
+        let hidden = self.columns.iter().position(|c| c == "hidden");
+        let dim = hidden.unwrap_or(last) - 4;
+        let centroid = self
+            .rows
+            .iter()
+            .flat_map(|r| r[4..4 + dim].to_vec())
+            .collect();
         let named = |name: &str, data: NpyData, cols: Option<usize>| NpyArray {
             name: name.to_string(),
             data,
             cols,
         };
-        encode_npz(&[
+        let mut arrays = vec![
             named("id", ints(0), None),
             named("volume", floats(1), None),
             named("neighbours", ints(2), None),
             named("surface_area", floats(3), None),
             named("centroid", NpyData::F64(centroid), Some(dim)),
-            named("duplicate_of", ints(last), None),
-        ])
+        ];
+        if let Some(k) = hidden {
+            arrays.push(named("hidden", ints(k), None));
+        }
+        arrays.push(named("duplicate_of", ints(last), None));
+        encode_npz(&arrays)
     }
 }
 

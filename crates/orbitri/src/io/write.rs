@@ -72,7 +72,8 @@ fn json_f64_writes_null_for_non_finite_numbers() {
 
 /// JSON: `{"dimension", "sheets"`, the space ([`SpaceFormat::json_space`]: a torus's
 /// `"lattice"`, a manifold's `"space"` and `"group"`), `"points"` (wrapped, input order),
-/// `"first_occurrence", "cells"` and the cells' elements (a torus's `"offsets"`, a manifold's
+/// `"first_occurrence"`, for weighted points `"weights"` and `"hidden"` (sorted input ids),
+/// `"cells"` and the cells' elements (a torus's `"offsets"`, a manifold's
 /// `"elements"`, one `[A, t]` per vertex)`}`, written as it is produced.
 pub fn write_json<const D: usize, const N: usize, S: SpaceFormat<D, N>>(
     w: &mut impl Write,
@@ -88,10 +89,16 @@ pub fn write_json<const D: usize, const N: usize, S: SpaceFormat<D, N>>(
     write_list(
         w,
         (0..tri.number_of_input_points())
-            .map(|i| json_point(&tri.point(tri.vertex_of_input(InputId::new(i))))),
+            .map(|i| json_point(&tri.position(InputId::new(i), space.identity()))),
     )?;
     write!(w, "],\"first_occurrence\":[")?;
     write_list(w, tri.first_occurrences().iter().map(|x| x.to_string()))?;
+    if tri.is_weighted() {
+        write!(w, "],\"weights\":[")?;
+        write_list(w, tri.weights().iter().map(|&x| json_f64(x)))?;
+        write!(w, "],\"hidden\":[")?;
+        write_list(w, tri.hidden().iter().map(|x| x.to_string()))?;
+    }
     write!(w, "],\"cells\":[")?;
     write_list(
         w,

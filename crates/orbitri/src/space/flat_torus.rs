@@ -28,9 +28,6 @@ pub struct FlatTorus<const D: usize> {
     pub(super) lattice: Lattice<D>,
     ladder: Vec<Level<D>>,
     kind: Ladder,
-    /// The spread of the weights (largest − least, internal frame) the ladder and the dummy
-    /// points are safe for: 0 unless built by [`FlatTorus::for_spread`].
-    spread: f64,
 }
 
 /// The 2D flat torus.
@@ -74,7 +71,6 @@ impl<const D: usize> FlatTorus<D> {
             lattice,
             ladder,
             kind,
-            spread: 0.0,
         }
     }
 
@@ -106,7 +102,6 @@ impl<const D: usize> FlatTorus<D> {
             lattice: self.lattice.clone(),
             ladder,
             kind: self.kind,
-            spread,
         })
     }
 
@@ -114,21 +109,6 @@ impl<const D: usize> FlatTorus<D> {
     pub fn max_spread(&self) -> f64 {
         let longest = self.lattice.longest_covering_systole() * (1.0 - 1e-9);
         ((longest * longest / 4.0 - self.lattice.one_point_need().powi(2) / 4.0) / 4.0).max(0.0)
-    }
-
-    /// The dummy point set: a grid whose cells satisfy the switch criterion with points of
-    /// the least weight while `spread` more is allowed (`r² + W < δ²/16`); none when the
-    /// spread takes more than a quarter of it (a covering is the better start then).
-    pub(super) fn weighted_dummies(&self) -> Vec<[f64; D]> {
-        if self.spread == 0.0 {
-            return self.lattice.dummy_grid();
-        }
-        let d = self.lattice.systole_in();
-        let reduced = d * d - 16.0 * self.spread * (1.0 + 1e-6);
-        if reduced < d * d / 4.0 {
-            return Vec::new();
-        }
-        self.lattice.dummy_grid_for(reduced.sqrt(), 0, 1)
     }
 
     /// The coverings of the ladder, from level 0 (most sheets) to the torus.
@@ -739,7 +719,7 @@ macro_rules! flat_torus_plugin {
         }
 
         fn dummy_points(&self) -> Vec<Self::Point> {
-            self.weighted_dummies()
+            self.lattice.dummy_grid()
         }
     };
 }

@@ -348,8 +348,10 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         }
         let k = dummies.len() as u32;
         if self.engine.is_weighted() {
-            // the least weight: a dummy hides no point unless one lies on it
-            self.engine.weights = vec![self.weight_range.0; dummies.len()];
+            // the largest weight: no point hides a dummy (unless one of that weight lies on
+            // it), and the dummies' cells keep their unweighted criterion; the points the
+            // dummies hide come back once they leave
+            self.engine.weights = vec![self.weight_range.1; dummies.len()];
         }
         self.engine.points = dummies;
         self.engine.bootstrap_one_sheeted();
@@ -386,7 +388,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             .collect();
         self.engine.compact(&dummy);
         self.point_input.drain(..k as usize);
-        for p in self.input_point.iter_mut() {
+        for p in self.input_point.iter_mut().filter(|p| **p != HIDDEN) {
             *p = PointId(p.0 - k);
         }
         self.used_dummies = true;
