@@ -241,11 +241,11 @@ impl Weighting {
     }
 }
 
+/// Points, and their weights when weighted.
+type Input<const D: usize> = (Vec<[f64; D]>, Option<Vec<f64>>);
+
 /// The points of `input`, and their weights when `weighting` asks for them.
-fn read_input<const D: usize>(
-    input: &Path,
-    weighting: &Weighting,
-) -> Result<(Vec<[f64; D]>, Option<Vec<f64>>), CliError> {
+fn read_input<const D: usize>(input: &Path, weighting: &Weighting) -> Result<Input<D>, CliError> {
     Ok(match weighting.column() {
         Some(column) => {
             let (p, w) = orbitri::io::read_weighted_points(input, column)?;
