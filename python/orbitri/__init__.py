@@ -374,6 +374,25 @@ def _csr(rows, columns, n):
     return indptr, np.asarray(columns, dtype=np.int64)[order]
 
 
+def _weights(weights, radii, n):
+    """The weights of ``n`` points from ``weights`` or ``radii`` (weight ``r²``), or None;
+    a ``ValueError`` names a bad radius and its row, or both given."""
+    if weights is not None and radii is not None:
+        raise ValueError("give weights or radii, not both (a radius r is the weight r²)")
+    if radii is not None:
+        r = np.asarray(radii, dtype=float).reshape(-1)
+        bad = np.flatnonzero(~(np.isfinite(r) & (r >= 0)))
+        if bad.size:
+            raise ValueError(f"point {bad[0]}: radius {r[bad[0]]} is not a finite number ≥ 0")
+        weights = r * r
+    if weights is None:
+        return None
+    w = np.ascontiguousarray(weights, dtype=float).reshape(-1)
+    if w.shape[0] != n:
+        raise ValueError(f"{w.shape[0]} weights for {n} points: give one weight (or radius) per point")
+    return w
+
+
 class _Delaunay:
     """What every triangulation offers: ``PeriodicDelaunay`` (a torus) and ``Triangulation``
     (a closed flat manifold). Group elements, where they appear, are a torus's offsets (N ×
@@ -397,6 +416,19 @@ class _Delaunay:
     def dimension(self) -> int:
         """2 or 3."""
         return self._tri.dimension
+
+    @property
+    def weights(self):
+        """Each input's weight (a squared length; ``radii**2`` when radii were given), or
+        None for unweighted points."""
+        return self._tri.weights
+
+    @property
+    def hidden(self) -> np.ndarray:
+        """The hidden input ids, sorted: weighted points whose power cell is empty. They
+        have no vertex and a Voronoi volume of 0, and come back when a removal uncovers
+        them."""
+        return self._tri.hidden
 
     @property
     def points(self) -> np.ndarray:
@@ -469,9 +501,10 @@ class _Delaunay:
         """How many input points were outside the domain and wrapped into it."""
         return self._tri.number_of_wrapped
 
-    def insert(self, points) -> np.ndarray:
+    def insert(self, points, weights=None, radii=None) -> np.ndarray:
         """Inserts more points (their input ids follow the existing ones); returns for each
-        the input id of the vertex it became or coincides with.
+        the input id of the vertex it became or coincides with, −1 when hidden. A weighted
+        triangulation takes ``weights`` or ``radii`` (one per point; 0 if neither).
 
         All or nothing: every point is checked before any is inserted; the batch then goes
         in spatially sorted (BRIO + Hilbert), so a large batch in random order costs about
@@ -487,7 +520,11 @@ class _Delaunay:
         >>> tri.number_of_input_points
         2
         """
-        return self._tri.insert(_points(points, self.dimension))
+        p = _points(points, self.dimension)
+        w = _weights(weights, radii, len(p))
+        if w is None and self._tri.weights is not None:
+            w = np.zeros(len(p))
+        return self._tri.insert(p, w)
 
     def remove(self, ids) -> int:
         """Removes input points (one id or a sequence of ids), all or none. The other ids
@@ -641,13 +678,23 @@ class PeriodicDelaunay(_Delaunay):
     (0, 3)
     >>> orbitri.PeriodicDelaunay([[0.1, 0.2, 0.0], [0.6, 0.7, 0.0]], [1.0, 1.0]).dimension
     2
+
+    Weighted points (atoms or grains of given radii): ``weights=`` (squared lengths) or
+    ``radii=`` give the regular triangulation, whose ``voronoi()`` cells are the power
+    (Laguerre, radical) cells; a point whose power cell is empty is ``hidden``:
+
+    >>> tri = orbitri.PeriodicDelaunay([[0.1, 0.1], [0.6, 0.2], [0.62, 0.21], [0.3, 0.7]],
+    ...                                [1.0, 1.0], radii=[0.1, 0.2, 0.0, 0.1])
+    >>> tri.hidden.tolist(), round(float(tri.voronoi().volumes.sum()), 12)
+    ([2], 1.0)
     """
 
-    def __init__(self, points, box=None):
+    def __init__(self, points, box=None, weights=None, radii=None):
         if box is None:
             points, box = _system(points)
         p = _points(points, _box(box)[1])
-        super().__init__(_Triangulation(p, lattice_matrix(box, p.shape[1])))
+        w = _weights(weights, radii, len(p))
+        super().__init__(_Triangulation(p, lattice_matrix(box, p.shape[1]), w))
 
     def __repr__(self) -> str:
         return f"<orbitri.PeriodicDelaunay: {self._describe()}, box {Box(self.lattice)!r}>"
@@ -799,10 +846,11 @@ class Triangulation(_Delaunay):
         return vertices, elements, (int(coset), offset)
 
 
-def periodic_voronoi(points, box=None) -> "Voronoi":
+def periodic_voronoi(points, box=None, weights=None, radii=None) -> "Voronoi":
     """The periodic Voronoi cells of points in a box: ``PeriodicDelaunay(points,
     box).voronoi()``; ``periodic_voronoi(system)`` takes an ASE ``Atoms``, an MDAnalysis
-    ``Universe`` or ``AtomGroup``, or freud's ``(box, points)``.
+    ``Universe`` or ``AtomGroup``, or freud's ``(box, points)``. With ``weights=`` or
+    ``radii=``, the power (Laguerre) cells.
 
     >>> import numpy as np, orbitri
     >>> vor = orbitri.periodic_voronoi(np.random.default_rng(2).random((500, 2)), [1.0, 1.0])
@@ -813,7 +861,7 @@ def periodic_voronoi(points, box=None) -> "Voronoi":
     >>> round(float(orbitri.periodic_voronoi((box, points)).volumes.sum()), 6)
     1000.0
     """
-    return PeriodicDelaunay(points, box).voronoi()
+    return PeriodicDelaunay(points, box, weights=weights, radii=radii).voronoi()
 
 
 class Voronoi:

@@ -250,14 +250,29 @@ fn build<const D: usize, const N: usize, S: Served<D, N>>(
     points: Vec<[f64; D]>,
     space: S,
 ) -> PyResult<Tri_<D, N, S>> {
+    build_weighted(py, points, None, space)
+}
+
+/// [`build`] with weights (one per point) when given: the regular triangulation.
+fn build_weighted<const D: usize, const N: usize, S: Served<D, N>>(
+    py: Python<'_>,
+    points: Vec<[f64; D]>,
+    weights: Option<Vec<f64>>,
+    space: S,
+) -> PyResult<Tri_<D, N, S>> {
     interruptible(py, points.len(), move |stop| {
-        Tri_::build_with(space, &points, BuildOptions::default(), |_| {
+        let progress = |_| {
             if stop.load(Ordering::Relaxed) {
                 ControlFlow::Break(())
             } else {
                 ControlFlow::Continue(())
             }
-        })
+        };
+        let opts = BuildOptions::default();
+        match weights {
+            Some(w) => Tri_::build_weighted_with(space, &points, &w, opts, progress),
+            None => Tri_::build_with(space, &points, opts, progress),
+        }
         .map_err(value_error)
     })
 }
@@ -267,12 +282,13 @@ fn build<const D: usize, const N: usize, S: Served<D, N>>(
 fn insert_all<const D: usize, const N: usize, S: Served<D, N>>(
     t: &mut Tri_<D, N, S>,
     flat: &[f64],
+    weights: &[f64],
 ) -> orbitri::Result<Vec<i64>> {
     let points: Vec<[f64; D]> = flat
         .chunks_exact(D)
         .map(|q| std::array::from_fn(|c| q[c]))
         .collect();
-    Ok(t.insert_all(&points)?
+    Ok(t.insert_all_weighted(&points, weights)?
         .into_iter()
         .map(|r| match r {
             orbitri::Inserted::New(v) | orbitri::Inserted::Duplicate(v) => {
@@ -477,15 +493,19 @@ impl Triangulation {
 
 #[pymethods]
 impl Triangulation {
-    /// The triangulation of a flat torus given by its lattice (rows).
+    /// The triangulation of a flat torus given by its lattice (rows); with `weights` (one
+    /// per point, squared lengths) the regular triangulation.
     #[new]
+    #[pyo3(signature = (points, lattice, weights=None))]
     fn new(
         py: Python<'_>,
         points: PyArrayLike2<'_, f64, AllowTypeChange>,
         lattice: PyArrayLike2<'_, f64, AllowTypeChange>,
+        weights: Option<PyArrayLike1<'_, f64, AllowTypeChange>>,
     ) -> PyResult<Self> {
         let p = points.as_array();
         let l = lattice.as_array();
+        let w = weights.map(|w| w.as_array().to_vec());
         let d = p.shape()[1];
         if l.shape() != [d, d] {
             return Err(PyValueError::new_err(format!(
@@ -494,8 +514,8 @@ impl Triangulation {
             )));
         }
         let tri = match d {
-            2 => Tri::Two(build(py, rows(p), torus(l)?)?),
-            3 => Tri::Three(build(py, rows(p), torus(l)?)?),
+            2 => Tri::Two(build_weighted(py, rows(p), w, torus(l)?)?),
+            3 => Tri::Three(build_weighted(py, rows(p), w, torus(l)?)?),
             _ => {
                 return Err(PyValueError::new_err(format!(
                     "points must have 2 or 3 columns, not {d}"
@@ -534,6 +554,23 @@ impl Triangulation {
         self.dim
     }
 
+    /// Each input's weight (None when unweighted).
+    #[getter]
+    fn weights<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyArray1<f64>>>> {
+        Ok(with_tri!(&*self.read(py)?, t => {
+            t.is_weighted().then(|| t.weights().to_vec().into_pyarray(py))
+        }))
+    }
+
+    /// The hidden input ids, sorted (weighted points whose power cell is empty).
+    #[getter]
+    fn hidden<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<i64>>> {
+        Ok(with_tri!(&*self.read(py)?, t => {
+            let ids: Vec<i64> = t.hidden().iter().map(|i| i64::from(i.0)).collect();
+            ids.into_pyarray(py)
+        }))
+    }
+
     /// Counts the modifications of the cells (`insert`, `try_one_sheet`).
     #[getter]
     fn generation(&self) -> u64 {
@@ -560,7 +597,7 @@ impl Triangulation {
                 .map(InputId::new)
                 .flat_map(|i| {
                     if t.contains(i) {
-                        t.point(t.vertex_of_input(i)).to_vec()
+                        t.position(i, t.space().identity()).to_vec()
                     } else {
                         vec![f64::NAN; d]
                     }
@@ -641,16 +678,19 @@ impl Triangulation {
 
     /// Inserts points, all or none: every coordinate is checked first (an error names the
     /// row of `points` and the axis); returns the input id each became or coincides with.
+    #[pyo3(signature = (points, weights=None))]
     fn insert<'py>(
         &self,
         py: Python<'py>,
         points: PyArrayLike2<'_, f64, AllowTypeChange>,
+        weights: Option<PyArrayLike1<'_, f64, AllowTypeChange>>,
     ) -> PyResult<Bound<'py, PyArray1<i64>>> {
         let flat = self.rows_of(&points)?;
+        let w = weights.map_or_else(Vec::new, |w| w.as_array().to_vec());
         let mut guard = self.write(py)?;
         let tri = &mut *guard;
         let ids = py
-            .detach(|| with_tri!(tri, t => insert_all(t, &flat)))
+            .detach(|| with_tri!(tri, t => insert_all(t, &flat, &w)))
             .map_err(value_error)?;
         self.generation.fetch_add(1, Ordering::AcqRel);
         Ok(Array1::from(ids).into_pyarray(py))
