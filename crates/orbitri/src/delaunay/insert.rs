@@ -334,9 +334,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 pi = p;
             }
         }
-        if self.one_sheeted {
-            self.refill_locator();
-        }
+        // (the jump-and-walk grid is a cache checked on use: renumbered points need nothing)
         pi
     }
 
