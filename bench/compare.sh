@@ -34,7 +34,7 @@ for case in "cube 3 1,1,1" "square 2 1,1"; do
             for which in old new; do
                 bin=$old
                 [ "$which" = new ] && bin=$new
-                line=$(RAYON_NUM_THREADS=1 "$bin" voronoi "$pts" --box ${box//,/ } --stats -o /dev/null 2>&1 >/dev/null)
+                line=$(RAYON_NUM_THREADS=1 "$bin" voronoi "$pts" --box ${box//,/ } --stats --format csv -o /dev/null 2>&1 >/dev/null)
                 echo "which=$which input=$input N=$n rep=$rep $line $stamp" | tee -a "$raw"
             done
         done

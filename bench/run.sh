@@ -38,7 +38,7 @@ for case in "${cases[@]}"; do
         pts=$out/${input}_$n.txt
         [ -f "$pts" ] || "$orb" generate "$n" --seed 1 --dim "$dim" -o "$pts"
         for rep in $(seq "$reps"); do
-            line=$("$orb" triangulate "$pts" --box ${box//,/ } --stats -o /dev/null 2>&1 >/dev/null)
+            line=$("$orb" triangulate "$pts" --box ${box//,/ } --stats --format cells -o /dev/null 2>&1 >/dev/null)
             echo "tool=orbitri input=$input N=$n rep=$rep $line load1=$(load) $stamp" | tee -a "$raw"
             for c in ${cmds//,/ }; do
                 echo "tool=cgal input=$input rep=$rep $("$cgal" "$c" "$n" 1) load1=$(load) $stamp" | tee -a "$raw"
@@ -52,7 +52,7 @@ if [ "${CLUSTERED:-1}" = 1 ]; then
     n=100000
     python3 "$root/bench/clustered.py" "$n" "$out/clustered.txt" "$out/clustered_cgal.txt"
     for rep in $(seq "${CLUSTER_REPS:-3}"); do
-        line=$("$orb" triangulate "$out/clustered.txt" --box 1 1 1 --stats -o /dev/null 2>&1 >/dev/null)
+        line=$("$orb" triangulate "$out/clustered.txt" --box 1 1 1 --stats --format cells -o /dev/null 2>&1 >/dev/null)
         echo "tool=orbitri input=clustered N=$n rep=$rep $line load1=$(load) $stamp" | tee -a "$raw"
         for c in dump3f; do
             echo "tool=cgal input=clustered N=$n rep=$rep $("$cgal" "$c" "$out/clustered_cgal.txt" /dev/null) load1=$(load) $stamp" | tee -a "$raw"

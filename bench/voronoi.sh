@@ -22,7 +22,7 @@ for case in "cube 3 1,1,1" "square 2 1,1"; do
         [ -f "$pts" ] || "$orb" generate "$n" --seed 1 --dim "$dim" -o "$pts"
         for threads in 1 2; do
             for rep in $(seq "$reps"); do
-                line=$(RAYON_NUM_THREADS=$threads "$orb" voronoi "$pts" --box ${box//,/ } --stats -o /dev/null 2>&1 >/dev/null)
+                line=$(RAYON_NUM_THREADS=$threads "$orb" voronoi "$pts" --box ${box//,/ } --stats --format csv -o /dev/null 2>&1 >/dev/null)
                 echo "input=$input N=$n threads=$threads rep=$rep $line $stamp" | tee -a "$raw"
             done
         done
