@@ -522,6 +522,10 @@ class _Delaunay:
         """
         p = _points(points, self.dimension)
         w = _weights(weights, radii, len(p))
+        if w is not None and self._tri.weights is None:
+            raise ValueError(
+                "this triangulation is unweighted: build it with weights= or radii= to insert weighted points"
+            )
         if w is None and self._tri.weights is not None:
             w = np.zeros(len(p))
         return self._tri.insert(p, w)

@@ -85,3 +85,9 @@ def test_bad_weights_are_value_errors():
         orbitri.PeriodicDelaunay(p, [1, 1, 1], weights=[0, 0, np.nan, 0, 0, 0, 0, 0, 0, 0])
     with pytest.raises(ValueError, match="point 0: weight"):
         orbitri.PeriodicDelaunay(p, [1, 1, 1], weights=[1e9] + [0] * 9)
+
+
+def test_weights_need_a_weighted_triangulation():
+    tri = orbitri.PeriodicDelaunay(np.random.default_rng(2).random((20, 2)), [1, 1])
+    with pytest.raises(ValueError, match="unweighted"):
+        tri.insert([[0.5, 0.5]], weights=[0.1])

@@ -91,6 +91,8 @@ enum Command {
         input: PathBuf,
         #[command(flatten)]
         domain: Domain2,
+        #[command(flatten)]
+        weighting: Weighting,
         /// Output file: .svg or .png (the extension picks the format)
         #[arg(short = 'o', long)]
         output: PathBuf,
@@ -663,7 +665,13 @@ fn voronoi_in<const D: usize, const N: usize, S: SpaceFormat<D, N>>(
     Ok(())
 }
 
-fn draw(input: PathBuf, domain: Domain, output: PathBuf, opts: SvgOptions) -> Result<(), CliError> {
+fn draw(
+    input: PathBuf,
+    domain: Domain,
+    weighting: Weighting,
+    output: PathBuf,
+    opts: SvgOptions,
+) -> Result<(), CliError> {
     let ext = output.extension().and_then(|e| e.to_str());
     if !ext.is_some_and(|e| e.eq_ignore_ascii_case("svg") || e.eq_ignore_ascii_case("png")) {
         return Err(CliError::Usage(format!(
@@ -673,8 +681,8 @@ fn draw(input: PathBuf, domain: Domain, output: PathBuf, opts: SvgOptions) -> Re
         )));
     }
     match space(&domain)? {
-        Space::Torus2(s) => draw_in(s, &input, output, opts),
-        Space::Klein(s) => draw_in(s, &input, output, opts),
+        Space::Torus2(s) => draw_in(s, &input, &weighting, output, opts),
+        Space::Klein(s) => draw_in(s, &input, &weighting, output, opts),
         _ => Err(CliError::Usage(
             "draw renders 2D spaces: give --box LX LY, --lattice AX AY BX BY or --cellpar A B GAMMA (or --space klein --box L1 L2)".into(),
         )),
@@ -684,12 +692,13 @@ fn draw(input: PathBuf, domain: Domain, output: PathBuf, opts: SvgOptions) -> Re
 fn draw_in<S: Drawable>(
     space: S,
     input: &Path,
+    weighting: &Weighting,
     output: PathBuf,
     opts: SvgOptions,
 ) -> Result<(), CliError> {
-    let pts: Vec<[f64; 2]> = orbitri::io::read_points(input)?;
+    let (pts, weights) = read_input::<2>(input, weighting)?;
     opts.validate(pts.len()).map_err(option_error)?;
-    let (tri, _) = build(space, &pts, None)?;
+    let (tri, _) = build(space, &pts, weights.as_deref())?;
     let mut svg = Vec::new();
     orbitri::io::write_svg(&mut svg, &tri, &opts).map_err(|e| {
         // writing to memory fails only on options out of range (a picture too high)
@@ -957,6 +966,7 @@ fn main() -> ExitCode {
         Command::Draw {
             input,
             domain,
+            weighting,
             output,
             copies,
             width,
@@ -965,6 +975,7 @@ fn main() -> ExitCode {
         } => draw(
             input,
             domain.into(),
+            weighting,
             output,
             SvgOptions {
                 copies,

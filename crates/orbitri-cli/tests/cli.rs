@@ -1231,4 +1231,25 @@ fn weighted_points_on_the_command_line() {
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("point 1: radius -0.5"), "{err}");
+    // draw: one circle of radius √w per weighted point (and copy), hidden ones dashed
+    std::fs::write(&input, "0.2 0.2 0.1\n0.7 0.3 0.05\n0.72 0.31 0\n0.4 0.8 0.1\n").unwrap();
+    let svg = dir.path().join("w.svg");
+    let out = orbitri(&[
+        "draw",
+        input.to_str().unwrap(),
+        "--box",
+        "1",
+        "1",
+        "--radii",
+        "--copies",
+        "1",
+        "-o",
+        svg.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = std::fs::read_to_string(&svg).unwrap();
+    let weights = &text[text.find("<g id=\"weights\"").unwrap()..];
+    let weights = &weights[..weights.find("</g>").unwrap()];
+    assert_eq!(weights.matches("<circle").count(), 3, "{weights}");
+    assert_eq!(weights.matches("stroke-dasharray").count(), 0);
 }

@@ -131,7 +131,10 @@ fn weighted_sets_match_cgal() {
         let w: Vec<f64> = rows[1..].iter().map(|r| r[3]).collect();
         let dump = std::fs::read_to_string(data_dir().join(format!("{name}.dump3w"))).unwrap();
         let lines: Vec<&str> = dump.lines().collect();
-        let head: Vec<usize> = lines[0].split_whitespace().map(|s| s.parse().unwrap()).collect();
+        let head: Vec<usize> = lines[0]
+            .split_whitespace()
+            .map(|s| s.parse().unwrap())
+            .collect();
         let cells: Vec<[i64; 16]> = lines[1..lines.len() - 1]
             .iter()
             .map(|l| {
@@ -148,7 +151,10 @@ fn weighted_sets_match_cgal() {
             .unwrap();
         tri.is_valid().unwrap();
         let got_hidden: Vec<u32> = tri.hidden().iter().map(|i| i.0).collect();
-        assert_eq!(got_hidden, hidden, "{name}: hidden points differ from CGAL's");
+        assert_eq!(
+            got_hidden, hidden,
+            "{name}: hidden points differ from CGAL's"
+        );
         assert_eq!((tri.number_of_vertices(), head[3]), (head[1], hidden.len()));
         let ours = canonical_cells(&tri.cells(Copies::Unique));
         assert_eq!(ours.len(), head[2], "{name}");

@@ -4,11 +4,14 @@
 //! unweighted triangulation, a constant added to every weight, hidden points and their
 //! return after removals, and bad weights.
 
+mod common;
+
 use orbitri::sort::SplitMix;
 use orbitri::{
     Copies, Error, FlatTorus, InputId, Inserted, PeriodicDelaunay, PeriodicDelaunay2,
     PeriodicDelaunay3,
 };
+use proptest::prelude::*;
 
 /// Solves `A x = b` by Gaussian elimination with partial pivoting (independent of the
 /// library's geometry).
@@ -425,4 +428,124 @@ fn laguerre_cells() {
     let total: f64 = tri.voronoi_cells().iter().map(|c| c.volume).sum();
     assert!((total - 1.0).abs() < 1e-12, "{total}");
     assert!(!tri.hidden().is_empty());
+}
+
+/// The Klein bottle takes equal weights (its Delaunay triangulation) and refuses a spread.
+#[test]
+fn manifolds_take_equal_weights_only() {
+    let klein = orbitri::FlatManifold::klein_bottle(1.0, 1.0).unwrap();
+    let (pts, _) = random::<2>(200, 4, 1.0, 0.0);
+    let plain = orbitri::KleinTriangulation::build(klein.clone(), &pts).unwrap();
+    let same =
+        orbitri::KleinTriangulation::build_weighted(klein.clone(), &pts, &[0.01; 200]).unwrap();
+    same.is_valid().unwrap();
+    assert_eq!(plain.cells(Copies::Unique), same.cells(Copies::Unique));
+    let mut w = vec![0.0; 200];
+    w[9] = 0.001;
+    let e = orbitri::KleinTriangulation::build_weighted(klein, &pts, &w).unwrap_err();
+    assert!(matches!(e, Error::BadWeight { index: 9, .. }), "{e}");
+}
+
+/// A regular triangulation built point by point from empty (`new_weighted`, then
+/// `insert_all_weighted` and `insert_weighted`) is the bulk build's.
+#[test]
+fn incremental_equals_bulk() {
+    let space = FlatTorus::cuboid([1.0, 0.8, 1.2]).unwrap();
+    let (pts, w) = random::<3>(1500, 31, 0.8, 0.003);
+    let bulk = PeriodicDelaunay3::build_weighted(space.clone(), &pts, &w).unwrap();
+    let mut inc = PeriodicDelaunay3::new_weighted(space);
+    inc.insert_all_weighted(&pts[..700], &w[..700]).unwrap();
+    for k in 700..1500 {
+        inc.insert_weighted(pts[k], w[k]).unwrap();
+    }
+    inc.is_valid().unwrap();
+    assert_eq!(inc.hidden(), bulk.hidden());
+    assert_eq!(common::geometry(&inc), common::geometry(&bulk));
+    assert!(matches!(
+        inc.insert_all_weighted(&pts[..3], &w[..2]),
+        Err(Error::WeightCount {
+            points: 3,
+            weights: 2
+        })
+    ));
+}
+
+#[derive(Clone, Debug)]
+enum Op {
+    Insert([f64; 2], f64),
+    Remove(usize),
+    RemoveAll(usize, usize),
+    Move(usize, [f64; 2]),
+}
+
+fn op() -> impl Strategy<Value = Op> {
+    // grid coordinates and a few weights: coincident points of other weights, orthogonal
+    // ties and hidden points are common
+    let coord = (0u32..12).prop_map(|k| k as f64 / 12.0);
+    let point = [coord.clone(), coord];
+    let weight = (0u32..4).prop_map(|k| k as f64 * 0.002);
+    prop_oneof![
+        4 => (point.clone(), weight).prop_map(|(p, w)| Op::Insert(p, w)),
+        2 => any::<usize>().prop_map(Op::Remove),
+        1 => (any::<usize>(), 1usize..5).prop_map(|(a, k)| Op::RemoveAll(a, k)),
+        1 => (any::<usize>(), point).prop_map(|(i, p)| Op::Move(i, p)),
+    ]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig {
+        cases: std::env::var("PROPTEST_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(40),
+        ..ProptestConfig::default()
+    })]
+
+    /// Random weighted insertions, removals and moves on a grid: valid after every step,
+    /// every input a vertex, a duplicate or hidden, and at the end the fresh build's cells
+    /// and hidden points.
+    #[test]
+    fn random_weighted_sequences(ops in proptest::collection::vec(op(), 1..70)) {
+        let space = FlatTorus::cuboid([1.0, 1.0]).unwrap();
+        let mut tri = PeriodicDelaunay2::new_weighted(space.clone());
+        for (step, op) in ops.iter().enumerate() {
+            let live: Vec<usize> = (0..tri.number_of_input_points())
+                .filter(|&i| tri.contains(InputId::new(i)))
+                .collect();
+            match *op {
+                Op::Insert(p, w) => {
+                    tri.insert_weighted(p, w).unwrap();
+                }
+                Op::Remove(k) if !live.is_empty() => {
+                    tri.remove(InputId::new(live[k % live.len()])).unwrap();
+                }
+                Op::RemoveAll(a, k) if !live.is_empty() => {
+                    let mut ids: Vec<InputId> =
+                        (0..k).map(|j| InputId::new(live[(a + 5 * j) % live.len()])).collect();
+                    ids.sort_unstable();
+                    ids.dedup();
+                    tri.remove_all(&ids).unwrap();
+                }
+                Op::Move(k, p) if !live.is_empty() => {
+                    tri.move_point(InputId::new(live[k % live.len()]), p).unwrap();
+                }
+                _ => {}
+            }
+            if tri.number_of_vertices() > 0 {
+                prop_assert!(tri.is_valid().is_ok(), "step {step} {op:?}: {:?}", tri.is_valid());
+            }
+            let live = (0..tri.number_of_input_points()).filter(|&i| tri.contains(InputId::new(i))).count();
+            prop_assert_eq!(tri.number_of_vertices() + tri.duplicates() + tri.hidden().len(), live);
+        }
+        let live: Vec<usize> = (0..tri.number_of_input_points())
+            .filter(|&i| tri.contains(InputId::new(i)))
+            .collect();
+        if !live.is_empty() {
+            let pts: Vec<[f64; 2]> = live.iter().map(|&i| tri.position(InputId::new(i), [0, 0])).collect();
+            let ws: Vec<f64> = live.iter().map(|&i| tri.weights()[i]).collect();
+            let fresh = PeriodicDelaunay2::build_weighted(space, &pts, &ws).unwrap();
+            let hidden: Vec<InputId> = fresh.hidden().iter().map(|h| InputId::new(live[h.index()])).collect();
+            prop_assert_eq!(tri.hidden(), hidden);
+            if fresh.sheets() == tri.sheets() {
+                prop_assert!(common::geometry(&tri) == common::geometry(&fresh));
+            }
+        }
+    }
 }

@@ -362,6 +362,32 @@ fn voronoi_cells<S: Drawable>(page: &Page, tri: &Triangulation<2, 3, S>) -> Vec<
         .collect()
 }
 
+/// Weighted points: each input's circle of radius `√w` (none for `w ≤ 0`) at every place
+/// of the picture, dashed for a hidden point.
+fn weight_circles<S: Drawable>(page: &Page, tri: &Triangulation<2, 3, S>) -> String {
+    let mut out = String::new();
+    let first = tri.first_occurrences();
+    for (i, &w) in tri.weights().iter().enumerate() {
+        let id = crate::ids::InputId::new(i);
+        if w <= 0.0 || first[i] != id {
+            continue;
+        }
+        let p = tri.position(id, tri.space().identity());
+        let r = w.sqrt() * page.scale;
+        let dash = if tri.is_hidden(id) {
+            r#" stroke-dasharray="2,2""#
+        } else {
+            ""
+        };
+        let s = page.shape(vec![p]);
+        for t in page.places(&s) {
+            let (x, y) = page.px(t.apply(p));
+            let _ = writeln!(out, r#"<circle cx="{x:.2}" cy="{y:.2}" r="{r:.2}"{dash}/>"#);
+        }
+    }
+    out
+}
+
 /// Writes the picture as SVG. Options out of range (see [`SvgOptions::validate`]) give an
 /// error of kind `InvalidInput` whose inner error is the typed [`Error::InvalidOption`],
 /// before anything is written.
@@ -464,6 +490,14 @@ pub fn write_svg<S: Drawable>(
             }
         }
         write!(w, "<g id=\"points\">\n{pts}</g>\n")?;
+    }
+    if tri.is_weighted() {
+        writeln!(
+            w,
+            r##"<g id="weights" stroke="#555" stroke-width="{:.2}">{}</g>"##,
+            stroke * 0.6,
+            weight_circles(&page, tri)
+        )?;
     }
     writeln!(w, "</g>")?;
     // domain copies dashed, the original domain solid

@@ -103,6 +103,14 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
                 .max_by(|a, b| (a.1 - mean).abs().total_cmp(&(b.1 - mean).abs()))
                 .expect("a weight");
             let user = |x: f64| self.space().weight_to_user(x);
+            if self.space().max_spread() == 0.0 {
+                return Err(Error::BadWeight {
+                    index: first + k,
+                    what: "weight",
+                    value: user(x),
+                    why: "differs from the others: weights in this space must be equal (a spread of weights is for the flat tori)".into(),
+                });
+            }
             return Err(Error::WeightSpread {
                 index: first + k,
                 value: user(x),
