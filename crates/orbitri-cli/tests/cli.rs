@@ -1165,19 +1165,17 @@ fn weighted_points_on_the_command_line() {
         "0.1 0.1 0.1 0\n0.6 0.2 0.3 0.04\n0.3 0.7 0.5 0\n0.62 0.21 0.3 0\n0.8 0.8 0.9 0\n",
     )
     .unwrap();
+    // `orbitri CMD INPUT --box 1 1 1 EXTRA…`
+    let run = |cmd: &str, extra: &[&str]| {
+        let mut args = vec![cmd, input.to_str().unwrap(), "--box", "1", "1", "1"];
+        args.extend_from_slice(extra);
+        orbitri(&args)
+    };
     let csv = dir.path().join("cells.csv");
-    let out = orbitri(&[
+    let out = run(
         "voronoi",
-        input.to_str().unwrap(),
-        "--box",
-        "1",
-        "1",
-        "1",
-        "--weights",
-        "--stats",
-        "-o",
-        csv.to_str().unwrap(),
-    ]);
+        &["--weights", "--stats", "-o", csv.to_str().unwrap()],
+    );
     assert!(
         out.status.success(),
         "{}",
@@ -1200,17 +1198,7 @@ fn weighted_points_on_the_command_line() {
         .sum();
     assert!((vol - 1.0).abs() < 1e-12);
     let json = dir.path().join("t.json");
-    let out = orbitri(&[
-        "triangulate",
-        input.to_str().unwrap(),
-        "--box",
-        "1",
-        "1",
-        "1",
-        "--radii",
-        "-o",
-        json.to_str().unwrap(),
-    ]);
+    let out = run("triangulate", &["--radii", "-o", json.to_str().unwrap()]);
     assert!(
         out.status.success(),
         "{}",
@@ -1219,20 +1207,16 @@ fn weighted_points_on_the_command_line() {
     let text = std::fs::read_to_string(&json).unwrap();
     assert!(text.contains("\"weights\":[0.0,0.0016"), "{text}");
     std::fs::write(&input, "0.1 0.1 0.1 0\n0.6 0.2 0.3 -0.5\n").unwrap();
-    let out = orbitri(&[
-        "triangulate",
-        input.to_str().unwrap(),
-        "--box",
-        "1",
-        "1",
-        "1",
-        "--radii",
-    ]);
+    let out = run("triangulate", &["--radii"]);
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("point 1: radius -0.5"), "{err}");
     // draw: one circle of radius √w per weighted point (and copy), hidden ones dashed
-    std::fs::write(&input, "0.2 0.2 0.1\n0.7 0.3 0.05\n0.72 0.31 0\n0.4 0.8 0.1\n").unwrap();
+    std::fs::write(
+        &input,
+        "0.2 0.2 0.1\n0.7 0.3 0.05\n0.72 0.31 0\n0.4 0.8 0.1\n",
+    )
+    .unwrap();
     let svg = dir.path().join("w.svg");
     let out = orbitri(&[
         "draw",
@@ -1246,7 +1230,11 @@ fn weighted_points_on_the_command_line() {
         "-o",
         svg.to_str().unwrap(),
     ]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let text = std::fs::read_to_string(&svg).unwrap();
     let weights = &text[text.find("<g id=\"weights\"").unwrap()..];
     let weights = &weights[..weights.find("</g>").unwrap()];

@@ -201,26 +201,7 @@ pub fn in_sphere_metric<const D: usize, const N: usize>(
         }
         s
     });
-    let mut det = 0.0;
-    for (i, li) in l.iter().enumerate() {
-        let mut rows = [&[][..]; 3];
-        for (slot, k) in (0..N).filter(|&k| k != i).enumerate() {
-            rows[slot] = &d[k][..];
-        }
-        let minor = if D == 2 {
-            rows[0][0] * rows[1][1] - rows[0][1] * rows[1][0]
-        } else {
-            rows[0][0] * (rows[1][1] * rows[2][2] - rows[1][2] * rows[2][1])
-                - rows[0][1] * (rows[1][0] * rows[2][2] - rows[1][2] * rows[2][0])
-                + rows[0][2] * (rows[1][0] * rows[2][1] - rows[1][1] * rows[2][0])
-        };
-        // cofactor sign along the last column of the (D+1)×(D+1) matrix
-        if (i + D) & 1 == 0 {
-            det += li * minor;
-        } else {
-            det -= li * minor;
-        }
-    }
+    let det = expand_lifts(d, &l);
     let bmax = b.iter().fold(0.0f64, |m, &x| m.max(x));
     let prod: f64 = b.iter().product();
     let c = if D == 2 { 512.0 } else { 2048.0 };
@@ -264,16 +245,25 @@ pub fn power<const D: usize, const N: usize>(
         }
         s - dw[i]
     });
+    let det = expand_lifts(d, &l);
+    let t: f64 = (0..N)
+        .map(|i| lambda[i] * (0..N).filter(|&k| k != i).map(|k| b[k]).product::<f64>())
+        .sum();
+    // in conflict ⇔ the determinant has the sign of (−1)^D
+    let inside = if D & 1 == 0 { det } else { -det };
+    decide(inside, 1024.0 * U * t)
+}
+
+/// The determinant of the `(D+1)×(D+1)` matrix whose rows are `(d_i, l_i)`, expanded along
+/// its last column: `Σ_i ± l_i · det(d without row i)` (`D` 2 or 3).
+#[inline(always)]
+fn expand_lifts<const D: usize, const N: usize>(d: &[[f64; D]; N], l: &[f64; N]) -> f64 {
     let mut det = 0.0;
-    let mut t = 0.0;
     for (i, li) in l.iter().enumerate() {
         let mut rows = [&[][..]; 3];
-        let mut others = 1.0;
         for (slot, k) in (0..N).filter(|&k| k != i).enumerate() {
             rows[slot] = &d[k][..];
-            others *= b[k];
         }
-        t += lambda[i] * others;
         let minor = if D == 2 {
             rows[0][0] * rows[1][1] - rows[0][1] * rows[1][0]
         } else {
@@ -281,16 +271,14 @@ pub fn power<const D: usize, const N: usize>(
                 - rows[0][1] * (rows[1][0] * rows[2][2] - rows[1][2] * rows[2][0])
                 + rows[0][2] * (rows[1][0] * rows[2][1] - rows[1][1] * rows[2][0])
         };
-        // cofactor sign along the last column of the (D+1)×(D+1) matrix
+        // cofactor sign along the last column
         if (i + D) & 1 == 0 {
             det += li * minor;
         } else {
             det -= li * minor;
         }
     }
-    // in conflict ⇔ the determinant has the sign of (−1)^D
-    let inside = if D & 1 == 0 { det } else { -det };
-    decide(inside, 1024.0 * U * t)
+    det
 }
 
 /// The sign of `det` when its error is below `err`; an exact zero when everything is zero.

@@ -668,6 +668,32 @@ macro_rules! flat_torus_plugin {
             self.coincide_lifted(a, b)
         }
 
+        #[inline(always)]
+        fn power_test(
+            &self,
+            s: &[(Self::Point, Self::Elem); $n],
+            ws: &[f64; $n],
+            q: (Self::Point, Self::Elem),
+            wq: f64,
+        ) -> crate::predicates::Sign {
+            match self.power_raw(s, ws, q, wq) {
+                crate::predicates::Sign::Zero => {
+                    self.perturbed(s, q, |t| <Self as OrbitSpace<$n>>::orient(self, t))
+                }
+                sign => sign,
+            }
+        }
+
+        fn orthogonal(
+            &self,
+            s: &[(Self::Point, Self::Elem); $n],
+            ws: &[f64; $n],
+            q: (Self::Point, Self::Elem),
+            wq: f64,
+        ) -> bool {
+            self.power_raw(s, ws, q, wq) == crate::predicates::Sign::Zero
+        }
+
         fn levels(&self) -> usize {
             self.ladder().len()
         }

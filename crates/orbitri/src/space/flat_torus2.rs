@@ -101,18 +101,6 @@ impl OrbitSpace<3> for FlatTorus<2> {
         }
     }
 
-    #[inline(always)]
-    fn power_test(&self, s: &[L2; 3], ws: &[f64; 3], q: L2, wq: f64) -> Sign {
-        match self.power_raw(s, ws, q, wq) {
-            Sign::Zero => self.perturbed(s, q, |t| self.orient(t)),
-            sign => sign,
-        }
-    }
-
-    fn orthogonal(&self, s: &[L2; 3], ws: &[f64; 3], q: L2, wq: f64) -> bool {
-        self.power_raw(s, ws, q, wq) == Sign::Zero
-    }
-
     fn ortho_distance2(&self, s: &[L2; 3], ws: &[f64; 3]) -> f64 {
         let x = self.center_within(s, ws, RADIUS_TOLERANCE);
         x[0] * x[0] + x[1] * x[1]

@@ -131,18 +131,6 @@ impl OrbitSpace<4> for FlatTorus<3> {
         }
     }
 
-    #[inline(always)]
-    fn power_test(&self, s: &[L3; 4], ws: &[f64; 4], q: L3, wq: f64) -> Sign {
-        match self.power_raw(s, ws, q, wq) {
-            Sign::Zero => self.perturbed(s, q, |t| self.orient(t)),
-            sign => sign,
-        }
-    }
-
-    fn orthogonal(&self, s: &[L3; 4], ws: &[f64; 4], q: L3, wq: f64) -> bool {
-        self.power_raw(s, ws, q, wq) == Sign::Zero
-    }
-
     fn ortho_distance2(&self, s: &[L3; 4], ws: &[f64; 4]) -> f64 {
         let x = self.center_within(s, ws, RADIUS_TOLERANCE);
         x[0] * x[0] + x[1] * x[1] + x[2] * x[2]
