@@ -517,10 +517,11 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         if self.detach_duplicate(i, p) {
             return Ok(Removal::InPlace);
         }
+        let near = self.hidden_near(p);
         let how = self.engine.remove_point(p);
         self.rebuilds += (how == Removal::Rebuilt) as usize;
         self.forget_point(p);
-        self.uncover();
+        self.uncover_among(near);
         Ok(how)
     }
 

@@ -228,13 +228,43 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         }
     }
 
+    /// The hidden inputs that removing point `p` may uncover: a point whose power cell
+    /// becomes non-empty lies in one of the new cells, which fill `p`'s star, and the star
+    /// lies within the ball around `p` reaching its farthest neighbour (each of its cells is
+    /// the hull of `p` and neighbours). Sorted.
+    pub(super) fn hidden_near(&self, p: PointId) -> Vec<InputId> {
+        if self.hidden.is_empty() {
+            return Vec::new();
+        }
+        let e = &self.engine;
+        let space = self.space();
+        let at = (e.points()[p.index()], space.identity());
+        let reach = e
+            .neighbours(e.vertex_of_point(p))
+            .into_iter()
+            .map(|(w, g)| {
+                let d = space.lifted_difference((e.points()[e.point_of(w).index()], g), at);
+                d.iter().map(|x| x * x).sum::<f64>().sqrt()
+            })
+            .fold(0.0, f64::max);
+        let (ids, pts): (Vec<InputId>, Vec<[f64; D]>) =
+            self.hidden.iter().map(|(&i, &(x, _))| (i, x)).unzip();
+        let mut near = Vec::new();
+        space.near(at, &pts, reach, &mut near);
+        let mut out: Vec<InputId> = near.into_iter().map(|(k, _)| ids[k as usize]).collect();
+        out.dedup();
+        out
+    }
+
     /// After removals: inserts again every hidden point whose power cell is no longer
     /// empty (each insertion can only hide more, so one pass in input order suffices).
     pub(super) fn uncover(&mut self) {
-        if self.hidden.is_empty() {
-            return;
-        }
         let ids: Vec<InputId> = self.hidden.keys().copied().collect();
+        self.uncover_among(ids);
+    }
+
+    /// [`Self::uncover`] for the hidden inputs `ids` only (sorted).
+    pub(super) fn uncover_among(&mut self, ids: Vec<InputId>) {
         for i in ids {
             let Some(&(x, w)) = self.hidden.get(&i) else {
                 continue;
