@@ -271,12 +271,8 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
                 if k % 1024 == 0 && interrupt() {
                     return Err(Error::Interrupted);
                 }
-                let lifted = e.lifted_cell(c);
-                Ok(if e.is_weighted() {
-                    space.orthocenter(&lifted, &e.cell_weights(c))
-                } else {
-                    space.circumcenter(&lifted)
-                })
+                // (the circumcenter is the orthocenter of the zero weights unweighted cells have)
+                Ok(space.orthocenter(&e.lifted_cell(c), &e.cell_weights(c)))
             })
             .collect::<Result<_>>()?;
         let mut center = vec![[0.0; D]; slots];

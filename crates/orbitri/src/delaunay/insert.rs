@@ -84,10 +84,10 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             return true;
         }
         let (c, qo) = self.locate(p);
-        let vids = self.tds.cells[c.index()].v;
-        self.in_conflict(&self.lifted_cell(c), &vids, (p, qo), w)
+        self.cell_conflicts(c, (p, qo), w)
             || (0..N).any(|i| {
-                self.vertex_weight(vids[i]) == w && self.space.coincide(self.lifted(c, i), (p, qo))
+                self.vertex_weight(self.tds.cells[c.index()].v[i]) == w
+                    && self.space.coincide(self.lifted(c, i), (p, qo))
             })
     }
 
@@ -112,8 +112,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 }
                 if st != outside {
                     let qd = self.space.relative(qo, self.translation(c, i, d));
-                    let vids = self.tds.cells[d.index()].v;
-                    if self.in_conflict(&self.lifted_cell(d), &vids, (p, qd), wq) {
+                    if self.cell_conflicts(d, (p, qd), wq) {
                         self.tds.set_stamp(d, inside);
                         self.tds.prefetch_neighbours(d);
                         scratch.conflict.push((d, qd));
@@ -278,13 +277,10 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 }
             }
         }
-        if self.weighted {
-            let vids = self.tds.cells[c.index()].v;
-            if !self.in_conflict(&self.lifted_cell(c), &vids, (q.0, qo), wq) {
-                self.hint = c;
-                self.hint_shift = self.space.carry(q.1, qo);
-                return Err(Refused::Hidden);
-            }
+        if self.weighted && !self.cell_conflicts(c, (q.0, qo), wq) {
+            self.hint = c;
+            self.hint_shift = self.space.carry(q.1, qo);
+            return Err(Refused::Hidden);
         }
         self.find_conflicts(c, qo, q.0, wq);
         if self.one_sheeted && !self.guaranteed && !self.star_keeps_simplicial() {

@@ -20,7 +20,6 @@ use crate::space::{Lifted, OrbitSpace};
 use crate::tds::{Cell, Tds};
 
 pub use remove::{Moved, Removal};
-
 pub use validate::Invalid;
 
 /// A lifted point of the space `S` (cells of `N` vertices).
@@ -212,10 +211,16 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         }
     }
 
+    /// The weights of the vertices `vids` (zeros when unweighted).
+    #[inline(always)]
+    fn weights_of(&self, vids: &[VertexId; N]) -> [f64; N] {
+        vids.map(|v| self.vertex_weight(v))
+    }
+
     /// The weights of the vertices of cell `c` (zeros when unweighted).
     #[inline]
     pub fn cell_weights(&self, c: CellId) -> [f64; N] {
-        self.tds.cells[c.index()].v.map(|v| self.vertex_weight(v))
+        self.weights_of(&self.tds.cells[c.index()].v)
     }
 
     /// True when the lifted point `q` of weight `wq` conflicts with the positively oriented
@@ -230,11 +235,16 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         wq: f64,
     ) -> bool {
         if self.weighted {
-            let ws = vids.map(|v| self.vertex_weight(v));
-            self.space.power_test(s, &ws, q, wq) == Sign::Positive
+            self.space.power_test(s, &self.weights_of(vids), q, wq) == Sign::Positive
         } else {
             self.space.in_sphere(s, q) == Sign::Positive
         }
+    }
+
+    /// [`Self::in_conflict`] of the stored cell `c`, `q` lifted into its frame.
+    #[inline(always)]
+    pub(crate) fn cell_conflicts(&self, c: CellId, q: LiftedOf<S, N>, wq: f64) -> bool {
+        self.in_conflict(&self.lifted_cell(c), &self.tds.cells[c.index()].v, q, wq)
     }
 
     /// What the switch criterion compares with the squared radii of the ladder: the
@@ -244,7 +254,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     #[inline]
     pub(crate) fn radius2(&self, s: &LiftedCell<S, N>, vids: &[VertexId; N]) -> f64 {
         if self.weighted {
-            let ws = vids.map(|v| self.vertex_weight(v));
+            let ws = self.weights_of(vids);
             self.space.ortho_distance2(s, &ws) + (self.weight_max - ws[0])
         } else {
             self.space.circumradius2(s)

@@ -125,6 +125,34 @@ pub fn det<const D: usize>(rows: [&[BigInt; D]; D]) -> BigInt {
     }
 }
 
+/// The side of the in-sphere or power test from its exact rows `d_i = a_i − q` and lifts
+/// `l_i` (`|d_i|²`, or `|d_i|² − (w_i − w_q)` for weighted points): the sign of the
+/// `(D+1)×(D+1)` determinant of rows `(d_i, l_i)`, expanded along the lifts, times
+/// `(−1)^D`; positive when `q` is inside the sphere (in conflict with the orthogonal
+/// sphere) of the positively oriented `a_0..a_D`.
+pub fn lifted_side<const D: usize>(d: &[[BigInt; D]], l: &[BigInt]) -> Sign {
+    let n = D + 1;
+    let mut total = BigInt::from(0);
+    for i in 0..n {
+        let mut rows = [&d[0]; D];
+        for (slot, k) in (0..n).filter(|&k| k != i).enumerate() {
+            rows[slot] = &d[k];
+        }
+        let term = &l[i] * det::<D>(rows);
+        if (i + D) & 1 == 0 {
+            total += term;
+        } else {
+            total -= term;
+        }
+    }
+    let s = sign(&total);
+    if D & 1 == 0 {
+        s
+    } else {
+        s.flip()
+    }
+}
+
 /// `det [a; b; c]` of three rows.
 pub fn det3(a: &[BigInt; 3], b: &[BigInt; 3], c: &[BigInt; 3]) -> BigInt {
     &a[0] * (&b[1] * &c[2] - &b[2] * &c[1]) - &a[1] * (&b[0] * &c[2] - &b[2] * &c[0])

@@ -206,26 +206,10 @@ impl<const D: usize> FlatTorus<D> {
         let d: Vec<[BigInt; D]> = (0..N)
             .map(|i| std::array::from_fn(|c| &l[i][c] - &l[N][c]))
             .collect();
-        let mut det = BigInt::from(0);
-        for i in 0..N {
-            let lift = d[i].iter().map(|x| x * x).sum::<BigInt>() - (&w[i] - &w[N]);
-            let mut rows = [&d[0]; D];
-            for (slot, k) in (0..N).filter(|&k| k != i).enumerate() {
-                rows[slot] = &d[k];
-            }
-            let term = lift * exact::det::<D>(rows);
-            if (i + D) & 1 == 0 {
-                det += term;
-            } else {
-                det -= term;
-            }
-        }
-        let sign = exact::sign(&det);
-        if D & 1 == 0 {
-            sign
-        } else {
-            sign.flip()
-        }
+        let lifts: Vec<BigInt> = (0..N)
+            .map(|i| d[i].iter().map(|x| x * x).sum::<BigInt>() - (&w[i] - &w[N]))
+            .collect();
+        exact::lifted_side(&d, &lifts)
     }
 
     /// The lifted difference `a − b` in Cartesian coordinates, to within `6u` of its

@@ -129,34 +129,18 @@ impl<const D: usize> Gram<D> {
                     .collect()
             })
             .collect();
-        let mut det = BigInt::from(0);
-        for i in 0..N {
-            let mut len = BigInt::from(0);
-            for j in 0..D {
-                for k in 0..D {
-                    len += &g[j][k] * &d[i][j] * &d[i][k];
+        let lifts: Vec<BigInt> = (0..N)
+            .map(|i| {
+                let mut len = BigInt::from(0);
+                for j in 0..D {
+                    for k in 0..D {
+                        len += &g[j][k] * &d[i][j] * &d[i][k];
+                    }
                 }
-            }
-            let len = (len << lift_shift) - &dw[i];
-            let rows: Vec<&[BigInt; D]> = (0..N).filter(|&k| k != i).map(|k| &d[k]).collect();
-            let minor = if D == 2 {
-                &rows[0][0] * &rows[1][1] - &rows[0][1] * &rows[1][0]
-            } else {
-                let r = |k: usize| -> [BigInt; 3] { std::array::from_fn(|c| rows[k][c].clone()) };
-                exact::det3(&r(0), &r(1), &r(2))
-            };
-            if (i + D) & 1 == 0 {
-                det += len * minor;
-            } else {
-                det -= len * minor;
-            }
-        }
-        let sign = exact::sign(&det);
-        if D & 1 == 0 {
-            sign
-        } else {
-            sign.flip()
-        }
+                (len << lift_shift) - &dw[i]
+            })
+            .collect();
+        exact::lifted_side(&d, &lifts)
     }
 }
 

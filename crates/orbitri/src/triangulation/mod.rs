@@ -110,10 +110,9 @@ pub struct Triangulation<const D: usize, const N: usize, S: FlatSpace<D, N> = Fl
     /// Weighted: the hidden inputs (their `input_point` is [`HIDDEN`]), each with its
     /// wrapped point and weight in the internal frame, to come back when uncovered.
     hidden: BTreeMap<InputId, ([f64; D], f64)>,
-    /// Weighted: the least and largest internal weight given, and the spread the space's
-    /// coverings are safe for.
+    /// Weighted: the least and largest internal weight given; the space's coverings are
+    /// for their spread (see [`Self::widen`]).
     weight_range: (f64, f64),
-    spread: f64,
 }
 
 /// `input_point` of a hidden input.
@@ -212,7 +211,6 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             input_weight: Vec::new(),
             hidden: BTreeMap::new(),
             weight_range: (f64::INFINITY, f64::NEG_INFINITY),
-            spread: 0.0,
         }
     }
 

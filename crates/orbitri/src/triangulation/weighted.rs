@@ -73,22 +73,28 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             tri.engine.weight_max = self.engine.weight_max;
             tri.input_weight = self.input_weight.clone();
             tri.weight_range = self.weight_range;
-            tri.spread = self.spread;
         }
         tri
     }
 
+    /// The spread of the weights given (largest − least, internal frame; 0 for none): the
+    /// space's coverings are for it, since the range only grows and the space follows.
+    fn spread(&self) -> f64 {
+        let (lo, hi) = self.weight_range;
+        (hi - lo).max(0.0)
+    }
+
     /// Takes the internal weights `w` (of inputs `first..`) into the weight range: when the
-    /// spread grows past what the space is for, the space is replaced by one for the new
-    /// spread (the triangulation, if any, moves to its coverings). An error names the
-    /// input that spreads the weights too far, and changes nothing.
+    /// spread grows, the space is replaced by one for the new spread (the triangulation, if
+    /// any, moves to its coverings). An error names the input that spreads the weights too
+    /// far, and changes nothing.
     fn widen(&mut self, w: &[f64], first: usize) -> Result<()> {
         let (mut lo, mut hi) = self.weight_range;
         for &x in w {
             lo = lo.min(x);
             hi = hi.max(x);
         }
-        if w.is_empty() || hi - lo <= self.spread {
+        if w.is_empty() || hi - lo <= self.spread() {
             (self.weight_range, self.engine.weight_max) =
                 ((lo, hi), hi.max(self.engine.weight_max));
             return Ok(());
@@ -119,7 +125,6 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             });
         };
         self.weight_range = (lo, hi);
-        self.spread = spread;
         self.engine.weight_max = hi.max(self.engine.weight_max);
         self.engine.replace_space(space);
         Ok(())
@@ -141,11 +146,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         }
         self.wrapped += moved as usize;
         self.input_point.push(PointId::NONE);
-        let r = self.insert_wrapped(InputId::new(i), x, wi);
-        Ok(match r {
-            Inserted::New(_) => Inserted::New(self.input_point[i]),
-            r => r,
-        })
+        Ok(self.insert_wrapped(InputId::new(i), x, wi))
     }
 
     /// [`Self::insert_all`] with weights (one per point, user units; ignored when the
