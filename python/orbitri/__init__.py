@@ -18,6 +18,10 @@ True
 
 from __future__ import annotations
 
+import os
+import sys
+import time
+
 import numpy as np
 
 from ._orbitri import PLATYCOSMS as _PLATYCOSMS
@@ -25,6 +29,7 @@ from ._orbitri import Space as _Space
 from ._orbitri import Triangulation as _Triangulation
 from ._orbitri import __version__
 from ._orbitri import cellpar_matrix as _cellpar_matrix
+from ._orbitri import set_progress_hook as _set_progress_hook
 
 __all__ = [
     "Box",
@@ -36,8 +41,103 @@ __all__ = [
     "Voronoi",
     "lattice_matrix",
     "periodic_voronoi",
+    "set_progress",
     "__version__",
 ]
+
+
+def _interactive() -> bool:
+    """True in a terminal session or a Jupyter kernel."""
+    if "ipykernel" in sys.modules:
+        return True
+    try:
+        return sys.stderr is not None and sys.stderr.isatty()
+    except (AttributeError, ValueError):
+        return False
+
+
+class _Bar:
+    """Shows the progress of a long computation on ``sys.stderr`` (through ``tqdm.auto``
+    when installed: a widget in Jupyter), from one second on: the phase, the percentage and
+    the time left, from the rate so far."""
+
+    def __init__(self):
+        self._reset()
+
+    def _reset(self):
+        self._phase, self._start, self._shown, self._tqdm, self._width = None, 0.0, 0.0, None, 0
+
+    def __call__(self, phase, done, total, finished):
+        now = time.monotonic()
+        if phase != self._phase:
+            self._close()
+            self._phase, self._start = phase, now
+        if finished:
+            self._close()
+            self._reset()
+            return
+        if now - self._start < 1.0 or total <= 0:
+            return
+        if self._tqdm is None and self._width == 0:
+            try:
+                from tqdm.auto import tqdm
+
+                self._tqdm = tqdm(total=total, desc=f"orbitri: {phase}", leave=False)
+            except ImportError:
+                pass
+        if self._tqdm is not None:
+            self._tqdm.update(done - self._tqdm.n)
+            return
+        if now - self._shown < 0.25:
+            return
+        self._shown = now
+        fraction = done / total
+        left = (now - self._start) * (1 - fraction) / fraction if fraction > 0 else None
+        eta = "" if left is None else f", {int(left) // 60}:{int(left) % 60:02d} left"
+        line = f"orbitri: {phase} {100 * fraction:3.0f}%{eta}"
+        self._width = max(self._width, len(line))
+        sys.stderr.write("\r" + line.ljust(self._width))
+        sys.stderr.flush()
+
+    def _close(self):
+        if self._tqdm is not None:
+            self._tqdm.update(self._tqdm.total - self._tqdm.n)
+            self._tqdm.close()
+        elif self._width:
+            sys.stderr.write("\r" + " " * self._width + "\r")
+            sys.stderr.flush()
+        self._tqdm, self._width = None, 0
+
+
+def set_progress(show="auto"):
+    """Whether long computations (a construction or ``voronoi()`` of 20 000 points or more)
+    show their progress: ``"auto"`` (the default) when interactive, in a terminal or a
+    Jupyter notebook; ``True`` always; ``False`` never; or a callable
+    ``show(phase, done, total, finished)`` of your own, called about every 50 ms while the
+    work runs and once with ``finished=True`` at the end (also after Ctrl-C). The bar
+    appears after one second, on ``sys.stderr`` (through ``tqdm`` when it is installed),
+    with the phase, the percentage and the time left. The environment variable
+    ``ORBITRI_PROGRESS=0`` or ``1`` sets the default.
+
+    >>> import orbitri
+    >>> seen = []
+    >>> orbitri.set_progress(lambda phase, done, total, finished: seen.append((phase, finished)))
+    >>> _ = orbitri.PeriodicDelaunay(np.random.default_rng(0).random((30_000, 2)), [1.0, 1.0])
+    >>> seen[-1]
+    ('triangulating', True)
+    >>> orbitri.set_progress(False)
+    """
+    if callable(show):
+        _set_progress_hook(show)
+    elif show == "auto":
+        _set_progress_hook(_Bar() if _interactive() else None)
+    elif show is True or show is False:
+        _set_progress_hook(_Bar() if show else None)
+    else:
+        raise ValueError(f"set_progress takes 'auto', True, False or a callable, not {show!r}")
+
+
+set_progress({"0": False, "1": True}.get(os.environ.get("ORBITRI_PROGRESS", ""), "auto"))
 
 
 def _numbers(args, what: str) -> np.ndarray:
@@ -437,17 +537,53 @@ class _Delaunay:
 
     @property
     def simplices(self) -> np.ndarray:
-        """Input ids of the vertices of every simplex (C × (D+1))."""
+        """Input ids of the vertices of every simplex of the space (C × (D+1)), one per
+        simplex of the space also while the triangulation is stored in a covering
+        (``sheets > 1``)."""
         return self._arrays()[0]
 
     @property
     def neighbors(self) -> np.ndarray:
-        """The simplex opposite each vertex of every simplex (C × (D+1))."""
+        """The simplex glued to each facet of every simplex (C × (D+1)): ``neighbors[c,
+        i]`` lies across the facet opposite vertex ``i``, through the boundary of the
+        domain if need be."""
         return self._arrays()[2]
 
     @property
+    def mirrors(self) -> np.ndarray:
+        """For every facet, its position in the neighbour (C × (D+1)): the facet of
+        simplex ``c`` opposite vertex ``i`` is the facet of ``neighbors[c, i]`` opposite
+        vertex ``mirrors[c, i]`` (CGAL's ``mirror_index``). With few points a simplex
+        may meet one neighbour through two facets, or itself, and a vertex may appear in
+        it twice (two images of one point): the triangulation is a Δ-complex, which
+        ``neighbors``, ``mirrors`` and ``gluings`` describe exactly."""
+        return self._arrays()[3]
+
+    @property
+    def gluings(self):
+        """The element that carries each neighbour onto its simplex (a torus's offsets,
+        C × (D+1) × D; a manifold's ``(cosets, offsets)``): the neighbour's vertex with
+        element ``g`` on the shared facet is the vertex of simplex ``c`` with element
+        ``gluings[c, i]∘g`` (in a torus, its offset plus ``gluings[c, i]``).
+
+        >>> import orbitri
+        >>> tri = orbitri.PeriodicDelaunay([[0.2, 0.3], [0.7, 0.6]], [1.0, 1.0])
+        >>> tri.sheets, len(tri.simplices)
+        (8, 4)
+        >>> c, i = 0, 0
+        >>> n, j = tri.neighbors[c, i], tri.mirrors[c, i]
+        >>> here = {(int(tri.simplices[c, k]), tuple(tri.offsets[c, k].tolist())) for k in range(3) if k != i}
+        >>> there = {(int(tri.simplices[n, k]), tuple((tri.offsets[n, k] + tri.gluings[c, i]).tolist())) for k in range(3) if k != j}
+        >>> here == there
+        True
+        """
+        return self._arrays()[4]
+
+    @property
     def sheets(self) -> int:
-        """1 once the triangulation is one of the space; more for too few points."""
+        """How the triangulation is stored: 1 once it is a triangulation of the space
+        itself; for too few points, the number of sheets of the covering space it lives
+        in. ``simplices`` and the other arrays describe the space either way."""
         return self._tri.sheets
 
     @property
@@ -671,9 +807,13 @@ class PeriodicDelaunay(_Delaunay):
     Arrays follow ``scipy.spatial.Delaunay``: ``simplices`` (C × (D+1) input ids, positively
     oriented), ``offsets`` (C × (D+1) × D: vertex ``k`` of simplex ``c`` lies at
     ``points[simplices[c, k]] + offsets[c, k] @ lattice``), ``neighbors`` (C × (D+1): the
-    simplex opposite each vertex). While the points are too few for the torus
-    (``sheets > 1``), these list every simplex of the covering space. The elements of
-    ``locate``, ``edges`` and ``vertex_neighbors`` are offsets too.
+    simplex opposite each vertex, across the boundary of the box if need be), with
+    ``mirrors`` and ``gluings`` for the way each pair is glued. They hold one simplex per
+    simplex of the torus, also while the points are too few for a triangulation of the
+    torus itself and it is stored in a covering space (``sheets > 1``): the torus's
+    triangulation is then a Δ-complex (a simplex may be its own neighbour, and a point may
+    be two of its vertices). The elements of ``locate``, ``edges``, ``vertex_neighbors``
+    and ``gluings`` are offsets too.
 
     >>> import orbitri
     >>> tri = orbitri.PeriodicDelaunay([[0.1, 0.2], [0.6, 0.4], [0.3, 0.8], [0.8, 0.9]] * 10

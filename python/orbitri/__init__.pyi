@@ -15,6 +15,7 @@ __all__ = [
     "Voronoi",
     "lattice_matrix",
     "periodic_voronoi",
+    "set_progress",
     "__version__",
 ]
 
@@ -22,6 +23,7 @@ _Ints = npt.NDArray[np.int32]
 _Floats = npt.NDArray[np.float64]
 
 def lattice_matrix(box: Any, dimension: int) -> _Floats: ...
+def set_progress(show: Any = ...) -> None: ...
 
 class Box:
     matrix: _Floats
@@ -86,6 +88,10 @@ class _Delaunay:
     def simplices(self) -> npt.NDArray[np.int64]: ...
     @property
     def neighbors(self) -> npt.NDArray[np.int64]: ...
+    @property
+    def mirrors(self) -> npt.NDArray[np.int64]: ...
+    @property
+    def gluings(self) -> Any: ...
     @property
     def sheets(self) -> int: ...
     @property

@@ -171,6 +171,43 @@ def test_tiny_sets_stay_correct_in_a_covering():
     assert abs(vor.volumes[0] - 1.0) < 1e-12 and vor.neighbor_counts[0] == 6
 
 
+def _check_glued(tri):
+    """Each facet of each simplex is its neighbour's facet at the mirror index, moved by the
+    gluing, and the gluings back are the opposites."""
+    s, o, n, m, g = tri.simplices, tri.offsets, tri.neighbors, tri.mirrors, tri.gluings
+    c, k = s.shape
+    for a in range(c):
+        for i in range(k):
+            b, j = n[a, i], m[a, i]
+            assert (n[b, j], m[b, j]) == (a, i)
+            np.testing.assert_array_equal(g[b, j], -g[a, i])
+            here = {(int(s[a, x]), tuple(o[a, x])) for x in range(k) if x != i}
+            there = {(int(s[b, x]), tuple(o[b, x] + g[a, i])) for x in range(k) if x != j}
+            assert here == there
+
+
+@pytest.mark.parametrize("n", [1, 2, 3, 5])
+def test_a_covering_is_described_as_the_torus(n):
+    # too few points for a simplicial complex on the torus: stored in a covering, described
+    # as the torus's own triangulation (a Δ-complex), one simplex per orbit
+    rng = np.random.default_rng(n)
+    for box in ([1.0, 1.0], [1.0, 1.0, 1.0]):
+        d = len(box)
+        tri = orbitri.PeriodicDelaunay(rng.random((n, d)), box)
+        assert tri.sheets > 1
+        lifted = tri.points[tri.simplices] + tri.offsets @ tri.lattice
+        vol = np.linalg.det(lifted[:, 1:] - lifted[:, :1]) / (2 if d == 2 else 6)
+        assert (vol > 0).all() and abs(vol.sum() - 1.0) < 1e-12
+        # Euler: 2D, F = 2V; 3D, E = V + C
+        if d == 2:
+            assert len(tri.simplices) == 2 * n
+        else:
+            assert len(tri.edges()[0]) == n + len(tri.simplices)
+        _check_glued(tri)
+        rows = tri.find_simplex(rng.random((50, d)))
+        assert rows.min() >= 0 and rows.max() < len(tri.simplices)
+
+
 def test_errors_are_value_errors_with_the_place():
     with pytest.raises(ValueError, match="point 1: coordinate 2 is NaN"):
         orbitri.PeriodicDelaunay([[0.1, 0.1, 0.1], [0.2, 0.2, np.nan]], [1, 1, 1])

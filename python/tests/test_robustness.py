@@ -22,13 +22,14 @@ def _canonical(simplices, offsets):
 
 
 def _check_fills_the_box(tri):
-    """Every stored simplex positively oriented, and (1-sheeted) their volumes fill the box."""
+    """Every simplex positively oriented, and their volumes fill the box once (one simplex
+    per simplex of the torus, also while it is stored in a covering)."""
     lifted = tri.points[tri.simplices] + tri.offsets @ tri.lattice
     d = lifted[:, 1:] - lifted[:, :1]
     vol = np.linalg.det(d) / (2 if tri.dimension == 2 else 6)
     assert (vol > 0).all()
     box = abs(np.linalg.det(tri.lattice))
-    assert abs(vol.sum() - tri.sheets * box) <= 1e-9 * box
+    assert abs(vol.sum() - box) <= 1e-9 * box
 
 
 # --- freud's 2D convention --------------------------------------------------------------
@@ -184,6 +185,8 @@ def test_try_one_sheet_brings_clustered_batches_to_the_bulk_result():
         tri.insert(batch)
     assert tri.sheets == 4 and not tri.is_one_sheeted
     _check_fills_the_box(tri)
+    # the covering's simplices, one per orbit, are the torus's Delaunay triangulation
+    assert _canonical(tri.simplices, tri.offsets) == _canonical(bulk.simplices, bulk.offsets)
     assert tri.try_one_sheet() is True
     assert tri.sheets == 1 and tri.is_one_sheeted
     _check_fills_the_box(tri)
@@ -276,3 +279,38 @@ def test_insert_of_a_point_out_of_reach_is_a_value_error_and_changes_nothing():
         tri.insert([[0.5, 0.5, 0.5], [1e300, 0.0, 0.0]])
     assert tri.number_of_input_points == 50
     assert _canonical(tri.simplices, tri.offsets) == cells
+
+
+@pytest.fixture
+def progress_off():
+    yield
+    orbitri.set_progress(False)
+
+
+def test_progress_reaches_a_hook_in_both_phases(progress_off):
+    calls = []
+    orbitri.set_progress(lambda *a: calls.append(a))
+    points = np.random.default_rng(4).random((300_000, 3))
+    orbitri.PeriodicDelaunay(points, [1.0, 1.0, 1.0]).voronoi()
+    phases = [c[0] for c in calls]
+    assert phases[0] == "triangulating" and phases[-1] == "Voronoi cells"
+    for phase in ("triangulating", "Voronoi cells"):
+        mine = [c for c in calls if c[0] == phase]
+        done = [c[1] for c in mine]
+        # reported while running, never backwards, never past the total, closed at the end
+        assert len(mine) >= 3, phase
+        assert done == sorted(done) and all(0 <= d <= c[2] for d, c in zip(done, mine))
+        assert mine[-1][3] is True and mine[-1][1] == mine[-1][2]
+        assert not any(c[3] for c in mine[:-1])
+
+
+def test_progress_bar_on_stderr(progress_off, capfd):
+    orbitri.set_progress(True)
+    orbitri.PeriodicDelaunay(np.random.default_rng(5).random((400_000, 3)), [1.0, 1.0, 1.0])
+    err = capfd.readouterr().err
+    assert "orbitri: triangulating" in err and "%" in err
+    orbitri.set_progress(False)
+    orbitri.PeriodicDelaunay(np.random.default_rng(5).random((400_000, 3)), [1.0, 1.0, 1.0])
+    assert "orbitri" not in capfd.readouterr().err
+    with pytest.raises(ValueError, match="set_progress takes"):
+        orbitri.set_progress("sometimes")

@@ -614,13 +614,12 @@ fn voronoi_in<const D: usize, const N: usize, S: SpaceFormat<D, N>>(
     let whole =
         matches!(format, VoronoiFormat::Json | VoronoiFormat::Vtu) || args.neighbours.is_some();
     let start = Instant::now();
-    // the Voronoi phase reports every 1024 triangulation cells (circumcenters), then every
-    // 1024 points (their cells)
+    // the Voronoi phase polls after about the same work each time: one step of the bar
     let n = tri.number_of_vertices();
-    let bar = progress_bar(n, tri.engine().cell_slots() + n, "Voronoi cells");
+    let bar = progress_bar(n, tri.voronoi_polls() as usize, "Voronoi cells");
     let tick = || {
         if let Some(b) = &bar {
-            b.inc(1024);
+            b.inc(1);
         }
         false
     };

@@ -50,6 +50,21 @@ fn random_text(n: usize) -> String {
     s
 }
 
+/// A `cells` file: its header's numbers, and its rows.
+fn cells_file(text: &str) -> (Vec<usize>, Vec<Vec<i64>>) {
+    let mut lines = text.lines();
+    let header = lines
+        .next()
+        .unwrap()
+        .split(' ')
+        .map(|s| s.parse().unwrap())
+        .collect();
+    let rows = lines
+        .map(|l| l.split(' ').map(|s| s.parse().unwrap()).collect())
+        .collect();
+    (header, rows)
+}
+
 #[test]
 fn cells_output_matches_the_library() {
     let dir = tempfile::tempdir().unwrap();
@@ -57,19 +72,9 @@ fn cells_output_matches_the_library() {
     let out = dir.path().join("cells.txt");
     let o = triangulate_cube(&input, &["-o", out.to_str().unwrap(), "--stats"]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let text = std::fs::read_to_string(&out).unwrap();
-    let mut lines = text.lines();
-    let header: Vec<usize> = lines
-        .next()
-        .unwrap()
-        .split(' ')
-        .map(|s| s.parse().unwrap())
-        .collect();
+    let (header, rows) = cells_file(&std::fs::read_to_string(&out).unwrap());
     assert_eq!(header[0], 1);
     assert_eq!(header[1], 1200);
-    let rows: Vec<Vec<i64>> = lines
-        .map(|l| l.split(' ').map(|s| s.parse().unwrap()).collect())
-        .collect();
     assert_eq!(rows.len(), header[2]);
     assert!(rows
         .iter()
@@ -90,6 +95,76 @@ fn cells_output_matches_the_library() {
         "peak_rss_kb=",
     ] {
         assert!(stats.contains(key), "missing {key} in {stats}");
+    }
+}
+
+/// A few points stay in the cube's 27-sheeted covering: the `cells` file and the JSON list
+/// the torus's cells (one per orbit), which fill the cube once, and the JSON's gluing makes
+/// each facet its neighbour's.
+#[test]
+fn a_covering_is_written_as_the_torus() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = write(dir.path(), "few.txt", &random_text(3));
+    let o = triangulate_cube(&input, &["--stats"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (header, rows) = cells_file(&String::from_utf8_lossy(&o.stdout));
+    assert_eq!((header[0], header[1], header[2]), (27, 3, rows.len()));
+    assert!(
+        stderr(&o).contains(&format!("cells={} sheets=27 ", rows.len())),
+        "{}",
+        stderr(&o)
+    );
+    let pts: Vec<[f64; 3]> = orbitri::io::read_points(&input).unwrap();
+    let corner = |r: &[i64], k: usize| -> Vec<f64> {
+        (0..3)
+            .map(|a| pts[r[k] as usize][a] + r[4 + 3 * k + a] as f64)
+            .collect()
+    };
+    let volume: f64 = rows
+        .iter()
+        .map(|r| {
+            let p: Vec<Vec<f64>> = (0..4).map(|k| corner(r, k)).collect();
+            let e: Vec<Vec<f64>> = (1..4)
+                .map(|k| (0..3).map(|a| p[k][a] - p[0][a]).collect())
+                .collect();
+            det(&e) / 6.0
+        })
+        .sum();
+    assert!((volume - 1.0).abs() < 1e-12, "the cells fill {volume}");
+    let o = triangulate_cube(&input, &["--format", "json"]);
+    let json: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let get = |key: &str| -> Vec<Vec<serde_json::Value>> {
+        serde_json::from_value(json[key].clone()).unwrap()
+    };
+    let (cells, offsets) = (get("cells"), get("offsets"));
+    let (neighbors, mirrors, gluings) = (get("neighbors"), get("mirrors"), get("gluings"));
+    assert_eq!(cells.len(), rows.len());
+    let offset = |v: &serde_json::Value| -> Vec<i64> { serde_json::from_value(v.clone()).unwrap() };
+    for c in 0..cells.len() {
+        for i in 0..4 {
+            let (n, j) = (
+                neighbors[c][i].as_u64().unwrap() as usize,
+                mirrors[c][i].as_u64().unwrap() as usize,
+            );
+            let g = offset(&gluings[c][i]);
+            let mut here: Vec<(u64, Vec<i64>)> = (0..4)
+                .filter(|&k| k != i)
+                .map(|k| (cells[c][k].as_u64().unwrap(), offset(&offsets[c][k])))
+                .collect();
+            let mut there: Vec<(u64, Vec<i64>)> = (0..4)
+                .filter(|&k| k != j)
+                .map(|k| {
+                    let o = offset(&offsets[n][k]);
+                    (
+                        cells[n][k].as_u64().unwrap(),
+                        (0..3).map(|a| o[a] + g[a]).collect(),
+                    )
+                })
+                .collect();
+            here.sort();
+            there.sort();
+            assert_eq!(here, there, "cell {c}, facet {i}");
+        }
     }
 }
 
@@ -794,9 +869,10 @@ fn domain_volume(name: &str, sides: &[&str]) -> f64 {
     }
 }
 
-/// The JSON of `triangulate` in a manifold: the group is there, and lifting every cell by
-/// its elements gives positively oriented simplices that fill the covering (`sheets` times
-/// the domain's volume).
+/// The JSON of `triangulate` in a manifold: the group is there; lifting every cell by its
+/// elements gives positively oriented simplices that fill the domain's volume once (one
+/// cell per orbit, also from a covering); and each facet, moved by its gluing, is the
+/// neighbour's facet at its mirror index.
 fn check_liftable_json(name: &str, sides: &[&str], json: &serde_json::Value) {
     let d = sides.len();
     assert_eq!(json["dimension"], d, "{name}");
@@ -839,11 +915,40 @@ fn check_liftable_json(name: &str, sides: &[&str], json: &serde_json::Value) {
         total += signed / if d == 2 { 2.0 } else { 6.0 };
     }
     let volume = domain_volume(name, sides);
-    let sheets = json["sheets"].as_f64().unwrap();
     assert!(
-        (total - sheets * volume).abs() < 1e-9 * sheets * volume,
-        "{name}: the cells fill {total}, not {sheets} × {volume}"
+        (total - volume).abs() < 1e-9 * volume,
+        "{name}: the cells fill {total}, not {volume}"
     );
+    let rows =
+        |key: &str| -> Vec<Vec<usize>> { serde_json::from_value(json[key].clone()).unwrap() };
+    let (neighbors, mirrors) = (rows("neighbors"), rows("mirrors"));
+    let gluings = json["gluings"].as_array().unwrap();
+    assert!(neighbors.len() == cells.len() && mirrors.len() == cells.len());
+    let lifted = |k: usize, skip: usize, by: Option<&Isometry>| -> Vec<Vec<f64>> {
+        let mut out: Vec<Vec<f64>> = (0..=d)
+            .filter(|&a| a != skip)
+            .map(|a| {
+                let x = apply(&isometry(&elements[k][a]), &points[cells[k][a]]);
+                by.map_or(x.clone(), |g| apply(g, &x))
+            })
+            .collect();
+        out.sort_by(|a, b| a.partial_cmp(b).unwrap());
+        out
+    };
+    for k in 0..cells.len() {
+        for i in 0..=d {
+            let (m, j) = (neighbors[k][i], mirrors[k][i]);
+            assert_eq!((neighbors[m][j], mirrors[m][j]), (k, i), "{name}");
+            let g = isometry(&gluings[k][i]);
+            let (here, there) = (lifted(k, i, None), lifted(m, j, Some(&g)));
+            for (a, b) in here.iter().zip(&there) {
+                assert!(
+                    a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-9),
+                    "{name}: cell {k} facet {i}: {here:?} is not {there:?}"
+                );
+            }
+        }
+    }
 }
 
 #[test]

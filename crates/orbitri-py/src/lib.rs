@@ -44,45 +44,105 @@ const POLL: Duration = Duration::from_millis(50);
 /// sooner than a helper thread would be worth.
 const SMALL: usize = 20_000;
 
-/// Runs `work` (of `size` points) without the interpreter and answers Ctrl-C.
+/// What a long computation shares with the thread that waits for it: the stop flag it
+/// polls, and how far it is (`done` of `total` units, for the progress hook).
+struct Control {
+    stop: AtomicBool,
+    done: AtomicU64,
+}
+
+impl Control {
+    /// True once the computation should stop.
+    fn stopped(&self) -> bool {
+        self.stop.load(Ordering::Relaxed)
+    }
+}
+
+/// The Python callable shown the progress of long computations (`set_progress_hook`):
+/// `hook(phase, done, total, finished)`, called on the main thread every `POLL`.
+static PROGRESS: Mutex<Option<Py<PyAny>>> = Mutex::new(None);
+
+/// Sets (or, with `None`, removes) the callable that shows the progress of long
+/// computations: `hook(phase, done, total, finished)`, called with the interpreter held on
+/// the thread that waits, about every 50 ms, and once with `finished` true at the end (also
+/// when interrupted). The package's `orbitri.set_progress` installs one.
+#[pyfunction]
+fn set_progress_hook(hook: Option<Py<PyAny>>) {
+    *PROGRESS.lock().unwrap_or_else(|e| e.into_inner()) = hook;
+}
+
+/// Shows the progress `(done, total)` of `phase` through the hook, if one is set.
+fn report(py: Python<'_>, phase: &str, done: u64, total: u64, finished: bool) -> PyResult<()> {
+    let hook = PROGRESS
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .as_ref()
+        .map(|h| h.clone_ref(py));
+    match hook {
+        Some(h) => h
+            .call1(py, (phase, done.min(total), total, finished))
+            .map(drop),
+        None => Ok(()),
+    }
+}
+
+/// Runs `work` (of `size` points; `total` units of progress, named `phase`) without the
+/// interpreter and answers Ctrl-C.
 ///
 /// On the main thread (the only one that receives signals), unless the input is small,
-/// `work` runs on a helper thread while this one waits detached and runs the signal handlers
-/// every `POLL`. Once a handler raises (`KeyboardInterrupt`), the call returns that
-/// exception at once: `work` sees `stop` raised at its next poll and ends in the background,
-/// its result dropped. Elsewhere `work` runs here, and `stop` is never raised.
+/// `work` runs on a helper thread while this one waits detached and, every `POLL`, runs the
+/// signal handlers and shows the progress `work` counts in `done` (`report`). Once a
+/// handler raises (`KeyboardInterrupt`), the call returns that exception at once: `work`
+/// sees `stop` raised at its next poll and ends in the background, its result dropped.
+/// Elsewhere `work` runs here, and `stop` is never raised.
 fn interruptible<T: Send + 'static>(
     py: Python<'_>,
     size: usize,
-    work: impl FnOnce(&AtomicBool) -> PyResult<T> + Send + 'static,
+    (phase, total): (&str, u64),
+    work: impl FnOnce(&Control) -> PyResult<T> + Send + 'static,
 ) -> PyResult<T> {
     let threading = py.import("threading")?;
     let main = threading
         .call_method0("main_thread")?
         .is(&threading.call_method0("current_thread")?);
+    let control = Arc::new(Control {
+        stop: AtomicBool::new(false),
+        done: AtomicU64::new(0),
+    });
     if !main || size < SMALL {
-        return py.detach(|| work(&AtomicBool::new(false)));
+        return py.detach(|| work(&control));
     }
-    let stop = Arc::new(AtomicBool::new(false));
-    let flag = Arc::clone(&stop);
+    let shared = Arc::clone(&control);
     let (tx, rx) = mpsc::channel();
     let worker = std::thread::Builder::new()
         .name("orbitri".into())
         // the main thread's size: the work would have run there
         .stack_size(8 << 20)
         .spawn(move || {
-            let _ = tx.send(work(&flag));
+            let _ = tx.send(work(&shared));
         })
         .map_err(|e| PyRuntimeError::new_err(format!("cannot start a thread: {e}")))?;
     // a `Receiver` is not `Sync`: the lock (only ever taken here) lets the wait run detached
     let rx = Mutex::new(rx);
+    let finish = |py| report(py, phase, total, total, true);
     loop {
         let next = py.detach(|| rx.lock().expect("one waiter").recv_timeout(POLL));
         match next {
-            Ok(result) => return result,
+            Ok(result) => {
+                finish(py)?;
+                return result;
+            }
             Err(mpsc::RecvTimeoutError::Timeout) => {
-                if let Err(e) = py.check_signals() {
-                    stop.store(true, Ordering::Relaxed);
+                let shown = report(
+                    py,
+                    phase,
+                    control.done.load(Ordering::Relaxed),
+                    total,
+                    false,
+                );
+                if let Err(e) = py.check_signals().and(shown) {
+                    control.stop.store(true, Ordering::Relaxed);
+                    let _ = finish(py);
                     return Err(e);
                 }
             }
@@ -260,9 +320,11 @@ fn build_weighted<const D: usize, const N: usize, S: Served<D, N>>(
     weights: Option<Vec<f64>>,
     space: S,
 ) -> PyResult<Tri_<D, N, S>> {
-    interruptible(py, points.len(), move |stop| {
-        let progress = |_| {
-            if stop.load(Ordering::Relaxed) {
+    let total = points.len() as u64;
+    interruptible(py, points.len(), ("triangulating", total), move |control| {
+        let progress = |k: usize| {
+            control.done.store(k as u64, Ordering::Relaxed);
+            if control.stopped() {
                 ControlFlow::Break(())
             } else {
                 ControlFlow::Continue(())
@@ -386,23 +448,38 @@ fn py_elements<const D: usize, const N: usize, S: Served<D, N>>(
         .unbind()
 }
 
-/// (simplices, elements, neighbors) of every stored cell.
+/// The cells of the space, one per orbit (`Triangulation::complex`): simplices, their
+/// elements, neighbors, mirrors and gluings.
+type ComplexArrays = (Py<PyAny>, Py<PyAny>, Py<PyAny>, Py<PyAny>, Py<PyAny>);
+
 fn simplices<const D: usize, const N: usize, S: Served<D, N>>(
     py: Python<'_>,
     t: &Tri_<D, N, S>,
-) -> (Py<PyAny>, Py<PyAny>, Py<PyAny>) {
-    let (cells, nbrs) = t.cells_with_neighbors();
-    let c = cells.len();
-    let v: Vec<i64> = cells
+) -> PyResult<ComplexArrays> {
+    let complex = t.complex().map_err(value_error)?;
+    let c = complex.cells.len();
+    let v: Vec<i64> = complex
+        .cells
         .iter()
         .flat_map(|x| x.vertices.map(|v| i64::from(v.0)))
         .collect();
-    let n: Vec<i64> = nbrs.iter().flat_map(|x| x.map(i64::from)).collect();
-    (
+    let n: Vec<i64> = complex
+        .neighbors
+        .iter()
+        .flat_map(|x| x.map(i64::from))
+        .collect();
+    let m: Vec<i64> = complex
+        .mirrors
+        .iter()
+        .flat_map(|x| x.map(i64::from))
+        .collect();
+    Ok((
         array2(py, c, N, v).into_any().unbind(),
-        py_elements::<D, N, S>(py, &[c, N], cells.iter().flat_map(|x| x.offsets)),
+        py_elements::<D, N, S>(py, &[c, N], complex.cells.iter().flat_map(|x| x.offsets)),
         array2(py, c, N, n).into_any().unbind(),
-    )
+        array2(py, c, N, m).into_any().unbind(),
+        py_elements::<D, N, S>(py, &[c, N], complex.gluings.into_iter().flatten()),
+    ))
 }
 
 /// (vertices, their elements, the point's element) of the cell containing `point`.
@@ -607,10 +684,11 @@ impl Triangulation {
         }))
     }
 
-    /// (simplices, elements, neighbors) of every stored cell: a torus's elements are its
-    /// offsets, a manifold's (cosets, offsets).
-    fn cells(&self, py: Python<'_>) -> PyResult<(Py<PyAny>, Py<PyAny>, Py<PyAny>)> {
-        Ok(with_tri!(&*self.read(py)?, t => simplices(py, t)))
+    /// The cells of the space, one per orbit also in a covering: (simplices, elements,
+    /// neighbors, mirrors, gluings); a torus's elements are its offsets, a manifold's
+    /// (cosets, offsets).
+    fn cells(&self, py: Python<'_>) -> PyResult<ComplexArrays> {
+        with_tri!(&*self.read(py)?, t => simplices(py, t))
     }
 
     #[getter]
@@ -811,13 +889,17 @@ impl Triangulation {
     /// The Voronoi cells of the points (computed without holding the interpreter; Ctrl-C
     /// stops them).
     fn voronoi(&self, py: Python<'_>) -> PyResult<Voronoi> {
-        let vertices = with_tri!(&*self.read(py)?, t => {
+        let (vertices, total) = with_tri!(&*self.read(py)?, t => {
             t.space().check_volume_representable().map_err(value_error)?;
-            t.number_of_vertices()
+            (t.number_of_vertices(), t.voronoi_polls())
         });
         let shared = Arc::clone(&self.tri);
-        let cells = interruptible(py, vertices, move |stop| {
-            let interrupt = || stop.load(Ordering::Relaxed);
+        // each poll follows about the same work: one unit of progress
+        let cells = interruptible(py, vertices, ("Voronoi cells", total), move |control| {
+            let interrupt = || {
+                control.done.fetch_add(1, Ordering::Relaxed);
+                control.stopped()
+            };
             Ok(match &*shared.read().map_err(poisoned)? {
                 Tri::Two(t) => Cells::Two(cells_of(t, &interrupt)?),
                 Tri::Three(t) => Cells::Three(cells_of(t, &interrupt)?),
@@ -1207,6 +1289,7 @@ fn cellpar_matrix<'py>(py: Python<'py>, p: Vec<f64>) -> PyResult<Bound<'py, PyAr
 fn _orbitri(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_function(wrap_pyfunction!(cellpar_matrix, m)?)?;
+    m.add_function(wrap_pyfunction!(set_progress_hook, m)?)?;
     m.add_class::<Triangulation>()?;
     m.add_class::<Voronoi>()?;
     m.add_class::<Space>()?;

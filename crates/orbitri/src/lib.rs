@@ -44,7 +44,8 @@ pub use space::{
     OrbitSpace,
 };
 pub use triangulation::{
-    BuildOptions, CellView, Copies, DelaunayEdge, KleinTriangulation, ManifoldTriangulation3,
-    PeriodicDelaunay, PeriodicDelaunay2, PeriodicDelaunay3, Simplex, Triangulation,
+    BuildOptions, CellView, Complex, Copies, DelaunayEdge, KleinTriangulation,
+    ManifoldTriangulation3, PeriodicDelaunay, PeriodicDelaunay2, PeriodicDelaunay3, Simplex,
+    Triangulation,
 };
 pub use voronoi::{CellMeasures, Neighbor, VoronoiCell, VoronoiFace};

@@ -38,7 +38,7 @@ fn tiny_sets_stay_in_the_covering_and_are_correct() {
         let f = tri.stored_facets().len();
         let v = tri.number_of_vertices() * tri.sheets();
         assert_eq!(
-            v as i64 - e as i64 + f as i64 - tri.number_of_cells() as i64,
+            v as i64 - e as i64 + f as i64 - tri.number_of_stored_cells() as i64,
             0
         );
     }

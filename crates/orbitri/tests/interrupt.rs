@@ -70,3 +70,41 @@ fn voronoi_stops_once_interrupted_and_is_unchanged_otherwise() {
         Err(Error::Interrupted)
     ));
 }
+
+/// The Voronoi cells poll exactly `voronoi_polls` times when not interrupted (a progress
+/// bar's total), also in a covering and for the measures; a stop at any poll is honoured.
+#[test]
+fn voronoi_polls_are_counted_in_advance() {
+    for n in [3, 5000, 20_000] {
+        let tri = PeriodicDelaunay3::build(torus(), &points(n)).unwrap();
+        let polls = AtomicUsize::new(0);
+        let count = || {
+            polls.fetch_add(1, Ordering::Relaxed);
+            false
+        };
+        assert_eq!(tri.voronoi_cells_until(&count).unwrap().len(), n);
+        assert_eq!(
+            polls.swap(0, Ordering::Relaxed) as u64,
+            tri.voronoi_polls(),
+            "{n}"
+        );
+        tri.voronoi_measures_until(&count).unwrap();
+        assert_eq!(
+            polls.swap(0, Ordering::Relaxed) as u64,
+            tri.voronoi_polls(),
+            "{n}"
+        );
+        // a stop at the last poll (the cells' phase) and in the middle (the merges')
+        for stop_at in [
+            tri.voronoi_polls() as usize,
+            tri.voronoi_polls() as usize / 2,
+        ] {
+            let late = || polls.fetch_add(1, Ordering::Relaxed) + 1 >= stop_at;
+            assert!(matches!(
+                tri.voronoi_cells_until(&late),
+                Err(Error::Interrupted)
+            ));
+            polls.store(0, Ordering::Relaxed);
+        }
+    }
+}

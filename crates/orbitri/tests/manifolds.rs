@@ -39,10 +39,6 @@ where
         "{what}: Voronoi volumes sum to {volume}, not {}",
         m.volume()
     );
-    if !tri.is_one_sheeted() {
-        // a covering (a few points): valid as a triangulation of the covering space
-        return;
-    }
     let turns = match m.name() {
         "tricosm" => 3,
         "hexacosm" => 6,

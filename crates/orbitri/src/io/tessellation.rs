@@ -13,7 +13,6 @@ use crate::ids::InputId;
 use crate::space::FlatSpace;
 use crate::triangulation::Triangulation;
 use crate::voronoi::{CellMeasures, VoronoiCell};
-use crate::Copies;
 
 const AXES: [&str; 3] = ["x", "y", "z"];
 
@@ -422,7 +421,7 @@ pub fn write_delaunay_vtu<const D: usize, const N: usize, S: FlatSpace<D, N>>(
     let mut v = Vtu::default();
     let mut index: HashMap<(InputId, S::Elem), i64> = HashMap::new();
     let mut pid = Vec::new();
-    for c in tri.cells(Copies::Unique) {
+    for c in super::write::complex_of(tri)?.cells {
         for k in 0..N {
             let key = (c.vertices[k], c.offsets[k]);
             let id = *index.entry(key).or_insert_with(|| {

@@ -4,29 +4,32 @@ use std::io::Write;
 
 use super::format::SpaceFormat;
 use crate::ids::InputId;
+use crate::space::FlatSpace;
 use crate::triangulation::Triangulation;
 
-/// The `cells` format: `SHEETS V C`, then per stored cell its `D + 1` input ids and their
-/// elements' integers ([`SpaceFormat::element_integers`]: a torus's offsets, `D` integers
-/// each in lattice units; a manifold's coset and offset, `1 + D` each), positively oriented
-/// (counter-clockwise in 2D). `V` counts distinct points, `C` the cell lines that follow (in
-/// a covering space: every stored copy).
+/// The `cells` format: `SHEETS V C`, then per cell of the space (one per orbit:
+/// [`Triangulation::complex`], also while the triangulation is stored in a covering of
+/// `SHEETS` sheets) its `D + 1` input ids and their elements' integers
+/// ([`SpaceFormat::element_integers`]: a torus's offsets, `D` integers each in lattice
+/// units; a manifold's coset and offset, `1 + D` each), positively oriented
+/// (counter-clockwise in 2D). `V` counts distinct points, `C` the cell lines that follow.
 pub fn write_cells<const D: usize, const N: usize, S: SpaceFormat<D, N>>(
     w: &mut impl Write,
     tri: &Triangulation<D, N, S>,
 ) -> std::io::Result<()> {
+    let cells = complex_of(tri)?.cells;
     writeln!(
         w,
         "{} {} {}",
         tri.sheets(),
         tri.number_of_vertices(),
-        tri.number_of_cells()
+        cells.len()
     )?;
     // integers through `itoa` into one reused line buffer: `write!` formatting took longer
     // than the triangulation itself
     let mut num = itoa::Buffer::new();
     let mut line: Vec<u8> = Vec::with_capacity(96);
-    for c in tri.stored_cells() {
+    for c in cells {
         line.clear();
         for v in c.vertices {
             line.extend_from_slice(num.format(v.0).as_bytes());
@@ -41,6 +44,15 @@ pub fn write_cells<const D: usize, const N: usize, S: SpaceFormat<D, N>>(
         w.write_all(&line)?;
     }
     Ok(())
+}
+
+/// The triangulation of the space, or the reason there is none as an I/O error (see
+/// [`Triangulation::complex`]).
+pub(super) fn complex_of<const D: usize, const N: usize, S: FlatSpace<D, N>>(
+    tri: &Triangulation<D, N, S>,
+) -> std::io::Result<crate::Complex<D, N, S::Elem>> {
+    tri.complex()
+        .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e.to_string()))
 }
 
 /// A JSON number: the shortest representation that reads back to the same double, or
@@ -73,8 +85,10 @@ fn json_f64_writes_null_for_non_finite_numbers() {
 /// JSON: `{"dimension", "sheets"`, the space ([`SpaceFormat::json_space`]: a torus's
 /// `"lattice"`, a manifold's `"space"` and `"group"`), `"points"` (wrapped, input order),
 /// `"first_occurrence"`, for weighted points `"weights"` and `"hidden"` (sorted input ids),
-/// `"cells"` and the cells' elements (a torus's `"offsets"`, a manifold's
-/// `"elements"`, one `[A, t]` per vertex)`}`, written as it is produced.
+/// then the triangulation of the space ([`Triangulation::complex`], one cell per orbit):
+/// `"cells"`, the cells' elements (a torus's `"offsets"`, a manifold's `"elements"`, one
+/// `[A, t]` per vertex), `"neighbors"`, `"mirrors"` and `"gluings"` (elements)`}`, written
+/// as it is produced.
 pub fn write_json<const D: usize, const N: usize, S: SpaceFormat<D, N>>(
     w: &mut impl Write,
     tri: &Triangulation<D, N, S>,
@@ -99,20 +113,31 @@ pub fn write_json<const D: usize, const N: usize, S: SpaceFormat<D, N>>(
         write!(w, "],\"hidden\":[")?;
         write_list(w, tri.hidden().iter().map(|x| x.to_string()))?;
     }
+    let complex = complex_of(tri)?;
+    let elements = |row: &[S::Elem]| {
+        let elements: Vec<String> = row.iter().map(|&g| space.json_element(g)).collect();
+        format!("[{}]", elements.join(","))
+    };
+    let numbers = |row: &[u32]| format!("{row:?}").replace(' ', "");
     write!(w, "],\"cells\":[")?;
     write_list(
         w,
-        tri.stored_cells()
-            .map(|c| format!("{:?}", c.vertices.map(u32::from)).replace(' ', "")),
+        complex
+            .cells
+            .iter()
+            .map(|c| numbers(&c.vertices.map(u32::from))),
     )?;
     write!(w, "],\"{}\":[", S::CELL_ELEMENTS)?;
+    write_list(w, complex.cells.iter().map(|c| elements(&c.offsets)))?;
+    write!(w, "],\"neighbors\":[")?;
+    write_list(w, complex.neighbors.iter().map(|n| numbers(n)))?;
+    write!(w, "],\"mirrors\":[")?;
     write_list(
         w,
-        tri.stored_cells().map(|c| {
-            let elements: Vec<String> = c.offsets.iter().map(|&g| space.json_element(g)).collect();
-            format!("[{}]", elements.join(","))
-        }),
+        complex.mirrors.iter().map(|m| numbers(&m.map(u32::from))),
     )?;
+    write!(w, "],\"gluings\":[")?;
+    write_list(w, complex.gluings.iter().map(|g| elements(g)))?;
     writeln!(w, "]}}")
 }
 

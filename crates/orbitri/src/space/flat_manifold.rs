@@ -17,8 +17,9 @@
 
 use super::flat_torus::{perturbed_by, UnperturbedInSphere, L};
 use super::lattice::{Ladder, Level};
+use super::left_order::LeftOrder;
 use super::metric::Gram;
-use super::{least_frame, least_translate, FlatSpace, FlatTorus, Lattice, OrbitSpace};
+use super::{least_frame, FlatSpace, FlatTorus, Lattice, OrbitSpace};
 use crate::error::{Error, Result};
 use crate::predicates::Sign;
 
@@ -117,6 +118,9 @@ pub struct FlatManifold<const D: usize> {
     ladder: Vec<Level<D>>,
     /// `δ(G)`: the least displacement of a non-identity element, internal frame.
     systole: f64,
+    /// The order of the copies of one point in the perturbation (none for a group that is
+    /// not left-orderable).
+    order: Option<LeftOrder<D>>,
     /// The domain is the part of `T`'s domain whose fractional coordinate along this axis
     /// is below `1/k`.
     slab_axis: usize,
@@ -401,12 +405,15 @@ impl<const D: usize> FlatManifold<D> {
             inverse,
             ladder,
             systole: 0.0,
+            order: None,
             slab_axis,
             scale,
             orbit_gap: need / 2.0 * scale,
             lattice_frame,
         };
         m.systole = m.least_displacement();
+        let actions: Vec<_> = m.cosets.iter().map(|c| (c.r, c.shift)).collect();
+        m.order = LeftOrder::new(&actions, q);
         if m.systole.is_nan() || m.systole <= 0.0 {
             return Err(not_a_group(
                 "an element other than the identity fixes a point".into(),
@@ -735,10 +742,8 @@ impl<const D: usize> FlatManifold<D> {
     }
 
     /// The perturbation of a tie of the in-sphere or power test of `q` against `s` (lifted
-    /// to `ls` and `lq`): one global order, distinct points by their stored coordinates
-    /// (invariant under the group), copies of one point by their lifted positions (invariant
-    /// under translations: copies meet in one test only in a covering, whose group is
-    /// translations).
+    /// to `ls` and `lq`): one global order of lifted points, distinct points by their
+    /// stored coordinates, copies of one point by [`Self::copy_order`].
     fn perturbed<const N: usize>(
         &self,
         s: &[(P<D>, Motion<D>); N],
@@ -750,19 +755,44 @@ impl<const D: usize> FlatManifold<D> {
         FlatTorus<D>: OrbitSpace<N, Point = [f64; D], Elem = [i8; D]>,
     {
         let kernel = self.kernel();
-        let at = |k: usize| if k == N { (q.0, lq) } else { (s[k].0, ls[k]) };
+        let at = |k: usize| if k == N { q } else { s[k] };
         perturbed_by(
             ls,
             lq,
             |t| kernel.orient(t),
             |a, b| {
-                let ((pa, la), (pb, lb)) = (at(a), at(b));
+                let ((pa, ga), (pb, gb)) = (at(a), at(b));
                 match pa.partial_cmp(&pb) {
-                    Some(std::cmp::Ordering::Equal) | None => kernel.compare_lifted(la, lb),
+                    Some(std::cmp::Ordering::Equal) | None => self.copy_order(ga, gb),
                     Some(o) => Sign::from(o),
                 }
             },
         )
+    }
+
+    /// The order of the copies `g·p` and `h·p` of one point (`Positive`: `g·p` comes
+    /// after), which must not change when both are moved by an element `k`, so that every
+    /// copy of a tie is broken alike. It depends on `x = g⁻¹∘h` alone (`k` cancels): `g·p`
+    /// comes first when `x` is positive in the group's left order ([`LeftOrder`]). A group
+    /// with none (the didicosm) orders copies by the coset of their element first, then by
+    /// `x`, a translation, lexicographically: a total order all the same, invariant for
+    /// ties among the translates of a copy (the ties of points in general position), and
+    /// not for a tie among copies in different cosets (points at special positions of the
+    /// screw axes), which [`crate::Triangulation::complex`] detects.
+    fn copy_order(&self, g: Motion<D>, h: Motion<D>) -> Sign {
+        let x = self.compose_elems(self.inverse_elem(g), h);
+        match &self.order {
+            Some(order) => {
+                let c = &self.cosets[x.coset as usize];
+                order
+                    .sign(std::array::from_fn(|i| {
+                        c.shift[i] + self.q * x.offset[i] as i32
+                    }))
+                    .flip()
+            }
+            None if g.coset != h.coset => Sign::from(g.coset.cmp(&h.coset)),
+            None => Sign::from(x.offset.cmp(&self.inverse_elem(x).offset)).flip(),
+        }
     }
 }
 
@@ -1122,8 +1152,8 @@ where
         })
     }
 
-    fn canonical_face(&self, pairs: &mut [(u32, Motion<D>)]) {
-        least_translate::<Self, N>(self, pairs)
+    fn face_frame(&self, pairs: &[(u32, Motion<D>)]) -> Motion<D> {
+        least_frame::<Self, N, u32>(self, pairs)
     }
 
     fn weight_to_internal(&self, w: f64) -> f64 {
@@ -1338,6 +1368,67 @@ mod tests {
             assert_eq!(homology(&m), (rank, torsion.to_vec()), "{name}");
         }
         assert_eq!(homology(&klein()), (1, vec![2]), "klein");
+    }
+
+    /// The sign of an element under the space's left order.
+    fn sign_of<const D: usize>(m: &FlatManifold<D>, g: Motion<D>) -> Sign {
+        let c = &m.cosets[g.coset as usize];
+        let tau = std::array::from_fn(|i| c.shift[i] + m.q * g.offset[i] as i32);
+        m.order.as_ref().expect("a left order").sign(tau)
+    }
+
+    /// Random elements of `m` with small offsets.
+    fn elements<const D: usize>(m: &FlatManifold<D>, n: usize) -> Vec<Motion<D>> {
+        let mut r = crate::sort::SplitMix::new(5);
+        (0..n)
+            .map(|_| Motion {
+                coset: (r.unit() * m.cosets.len() as f64) as u8,
+                offset: std::array::from_fn(|_| (r.unit() * 7.0) as i8 - 3),
+            })
+            .collect()
+    }
+
+    /// A left order: total (only the identity has sign zero), `x` and `x⁻¹` of opposite
+    /// signs, positives closed under products; and copies ranked by `g⁻¹∘h` keep their
+    /// order under every element.
+    fn check_left_order<const D: usize, const N: usize>(m: &FlatManifold<D>, what: &str)
+    where
+        FlatManifold<D>: OrbitSpace<N, Elem = Motion<D>>,
+    {
+        let els = elements(m, 40);
+        let one = OrbitSpace::<N>::identity(m);
+        assert_eq!(sign_of(m, one), Sign::Zero, "{what}");
+        for &x in &els {
+            let sx = sign_of(m, x);
+            assert_eq!(sx == Sign::Zero, x == one, "{what}: {x:?}");
+            assert_eq!(
+                sign_of(m, OrbitSpace::<N>::inverse(m, x)),
+                sx.flip(),
+                "{what}: {x:?}"
+            );
+            for &y in &els {
+                let xy = OrbitSpace::<N>::compose(m, x, y);
+                if sx == Sign::Positive && sign_of(m, y) == Sign::Positive {
+                    assert_eq!(sign_of(m, xy), Sign::Positive, "{what}: {x:?}·{y:?}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn every_group_but_the_didicosm_has_a_left_order() {
+        check_left_order::<2, 3>(&klein(), "klein");
+        for name in FlatManifold::PLATYCOSMS {
+            let m = FlatManifold::platycosm(name, [1.0, 1.0, 1.25]).unwrap();
+            if name == "didicosm" {
+                assert!(
+                    m.order.is_none(),
+                    "the Hantzsche–Wendt group is not left-orderable"
+                );
+            } else {
+                check_left_order::<3, 4>(&m, name);
+            }
+        }
     }
 
     #[test]

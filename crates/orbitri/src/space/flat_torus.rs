@@ -497,15 +497,9 @@ where
         self.coincide_lifted((from, t), (to, [0; D])).then_some(t)
     }
 
-    /// The componentwise least offset is translated to zero, then the pairs are sorted.
-    fn canonical_face(&self, pairs: &mut [(u32, [i8; D])]) {
-        for c in 0..D {
-            let m = pairs.iter().map(|p| p.1[c]).min().unwrap_or(0);
-            for p in pairs.iter_mut() {
-                p.1[c] -= m;
-            }
-        }
-        pairs.sort_unstable();
+    /// The translation that takes the componentwise least offset to zero.
+    fn face_frame(&self, pairs: &[(u32, [i8; D])]) -> [i8; D] {
+        std::array::from_fn(|c| -pairs.iter().map(|p| p.1[c]).min().unwrap_or(0))
     }
 
     fn weight_to_internal(&self, w: f64) -> f64 {

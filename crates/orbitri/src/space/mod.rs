@@ -7,6 +7,7 @@ mod flat_torus2;
 mod flat_torus3;
 mod klein_bottle;
 mod lattice;
+mod left_order;
 mod metric;
 mod platycosms;
 mod sublattice;
@@ -209,9 +210,19 @@ pub trait FlatSpace<const D: usize, const N: usize>:
     /// The element `g` with `g·from = to` exactly, when `from` and `to` (stored points) are
     /// two representatives of one point of the space.
     fn relating(&self, from: [f64; D], to: [f64; D]) -> Option<Self::Elem>;
-    /// A face given by (vertex, element) pairs in canonical form modulo the group: two
-    /// faces that differ by a group element get equal pairs, sorted.
-    fn canonical_face(&self, pairs: &mut [(u32, Self::Elem)]);
+    /// The canonical frame of a face given by (vertex, element) pairs: the element `h`
+    /// such that two faces that differ by a group element get equal pairs once each is
+    /// moved by its frame (`h∘g` for every element `g`) and sorted.
+    fn face_frame(&self, pairs: &[(u32, Self::Elem)]) -> Self::Elem;
+    /// A face in canonical form modulo the group: moved into its [`Self::face_frame`],
+    /// sorted.
+    fn canonical_face(&self, pairs: &mut [(u32, Self::Elem)]) {
+        let h = self.face_frame(pairs);
+        for p in pairs.iter_mut() {
+            p.1 = self.compose(h, p.1);
+        }
+        pairs.sort_unstable();
+    }
     /// A weight (a squared length) of the user in the internal frame: exact, or `inf`/`0`
     /// where the doubles cannot hold it.
     fn weight_to_internal(&self, w: f64) -> f64;
@@ -258,17 +269,4 @@ pub(crate) fn least_frame<S: OrbitSpace<N>, const N: usize, T: Ord + Copy>(
         }
     }
     frame.expect("at least one item")
-}
-
-/// [`FlatSpace::canonical_face`] for any group: the pairs moved into their
-/// [`least_frame`], sorted.
-pub(crate) fn least_translate<S: OrbitSpace<N>, const N: usize>(
-    space: &S,
-    pairs: &mut [(u32, S::Elem)],
-) {
-    let h = least_frame::<S, N, u32>(space, pairs);
-    for p in pairs.iter_mut() {
-        p.1 = space.compose(h, p.1);
-    }
-    pairs.sort_unstable();
 }

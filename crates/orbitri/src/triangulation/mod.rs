@@ -4,7 +4,10 @@
 //! space. `PeriodicDelaunay2` and `PeriodicDelaunay3` name the flat tori, `KleinBottle`
 //! and `FlatManifold3` the other closed flat manifolds.
 
+mod complex;
 mod weighted;
+
+pub use complex::Complex;
 
 use std::collections::{BTreeMap, HashSet};
 use std::ops::ControlFlow;
@@ -767,8 +770,20 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         self.engine.points().len()
     }
 
-    /// Number of stored cells (in the covering: all copies).
+    /// Number of cells of the space: one per orbit (the rows of [`Self::complex`]), also
+    /// while the triangulation is stored in a covering.
     pub fn number_of_cells(&self) -> usize {
+        if self.is_one_sheeted() {
+            self.engine.number_of_cells()
+        } else {
+            self.orbits().representatives.len()
+        }
+    }
+
+    /// Number of stored cells: in a covering space, every copy (`sheets` ×
+    /// [`Self::number_of_cells`] when the covering is the lift of a triangulation of the
+    /// space, see [`Self::complex`]).
+    pub fn number_of_stored_cells(&self) -> usize {
         self.engine.number_of_cells()
     }
 
@@ -850,31 +865,17 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         self.engine.cell_ids().map(|c| self.view(c))
     }
 
-    /// Every stored cell (as `stored_cells`) with its neighbours: `neighbors[k][i]` is the
-    /// position in this list of the cell opposite vertex `i` of cell `k`.
-    pub fn cells_with_neighbors(&self) -> (Vec<CellView<D, N, S::Elem>>, Vec<[u32; N]>) {
-        let ids: Vec<CellId> = self.engine.cell_ids().collect();
-        let slots = ids.iter().max().map_or(0, |m| m.index() + 1);
-        let mut position = vec![u32::MAX; slots];
-        for (k, &c) in ids.iter().enumerate() {
-            position[c.index()] = k as u32;
-        }
-        let views = ids.iter().map(|&c| self.view(c)).collect();
-        let neighbors = ids
-            .iter()
-            .map(|&c| self.engine.cell(c).n.map(|d| position[d.index()]))
-            .collect();
-        (views, neighbors)
-    }
-
-    /// The cells with input ids and offsets: every stored cell, or one per orbit.
+    /// The cells with input ids and elements: every stored cell, or one per orbit (the
+    /// cells of [`Self::complex`]).
     pub fn cells(&self, copies: Copies) -> Vec<CellView<D, N, S::Elem>> {
         if copies == Copies::Stored || self.is_one_sheeted() {
             return self.stored_cells().collect();
         }
-        let mut seen = HashSet::new();
-        self.stored_cells()
-            .filter(|c| seen.insert(canonical(self.space(), &c.vertices, &c.offsets)))
+        let orbits = self.orbits();
+        orbits
+            .representatives
+            .iter()
+            .map(|&c| self.view(c))
             .collect()
     }
 
@@ -1021,8 +1022,8 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         Ok((self.view(c), o))
     }
 
-    /// For every query point, the row of the stored cell containing it in
-    /// [`Self::cells`]`(Copies::Stored)` (scipy's `find_simplex`). The queries are taken in
+    /// For every query point, the row of the cell containing it in [`Self::complex`] (and
+    /// [`Self::cells`]`(Copies::Unique)`; scipy's `find_simplex`). The queries are taken in
     /// Hilbert order, in parallel chunks, each query walking from the previous one's cell,
     /// and each chunk's first from the jump-and-walk grid: the cost per query does not
     /// grow with the triangulation. An error names the first non-finite query by its row.
@@ -1031,10 +1032,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             return Err(Error::EmptyInput);
         }
         let (internal, _) = internal_points(self.space(), points)?;
-        let mut row = vec![usize::MAX; self.engine.cell_slots()];
-        for (k, c) in self.engine.cell_ids().enumerate() {
-            row[c.index()] = k;
-        }
+        let row: Vec<usize> = self.orbits().of.iter().map(|o| o.0 as usize).collect();
         let (internal, row) = (&internal, &row);
         let found: Vec<(u32, usize)> = hilbert_order(self.space(), internal)
             .par_chunks(4096)
