@@ -129,7 +129,10 @@ fn interruptible<T: Send + 'static>(
         let next = py.detach(|| rx.lock().expect("one waiter").recv_timeout(POLL));
         match next {
             Ok(result) => {
-                finish(py)?;
+                // a failing hook must not lose the finished work: its error is reported
+                if let Err(e) = finish(py) {
+                    e.write_unraisable(py, None);
+                }
                 return result;
             }
             Err(mpsc::RecvTimeoutError::Timeout) => {

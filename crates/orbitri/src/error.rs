@@ -72,7 +72,7 @@ pub enum Error {
     /// itself, so that it describes no triangulation of the space (see
     /// [`crate::Triangulation::complex`]).
     #[error(
-        "{points} points are too few for a triangulation of the space itself, and the triangulation of its {sheets}-sheeted covering breaks a tie among images of one point under different screw motions differently for different copies (the space's group, the didicosm's, has no order that every element respects), so it describes no triangulation of the space; add points (the Voronoi cells are exact either way)"
+        "{points} points are too few for a triangulation of the space itself, and the triangulation of its {sheets}-sheeted covering breaks a tie among images of one point under different screw motions differently for different copies (the space's group has no order that every element respects, as the didicosm's), so it describes no triangulation of the space; add points (the Voronoi cells are exact either way)"
     )]
     NotInvariant { points: usize, sheets: usize },
     /// The caller's progress or interrupt callback asked a long computation to stop.

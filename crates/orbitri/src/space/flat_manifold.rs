@@ -8,9 +8,10 @@
 //! signed permutation of the stored coordinates (exact) plus an integer combination of the
 //! rows of `M/q`: a lifted point of the flat torus of `M/q`, whose filters and exact
 //! fallbacks are reused as they are. The symbolic perturbation orders lifted points by
-//! their stored coordinates (one orbit, one stored point: invariant under `G`), and copies of
-//! one point, which meet in one test only in the coverings, by their lifted position
-//! (invariant under the translations the coverings have).
+//! their stored coordinates (one orbit, one stored point: invariant under `G`), and copies
+//! `g·p`, `h·p` of one point, which meet in one test in the coverings, by `g⁻¹∘h` in a
+//! left-invariant order of `G` (`left_order.rs`; the didicosm has none and is ordered by
+//! coset, then translation: see `FlatManifold::copy_order`).
 //!
 //! The covering ladder is the torus of `T`'s ladder (`k` sheets per torus sheet) followed by
 //! the manifold itself: Caroli–Teillaud's Theorem 10 with the translational subgroup.
@@ -1389,8 +1390,8 @@ mod tests {
     }
 
     /// A left order: total (only the identity has sign zero), `x` and `x⁻¹` of opposite
-    /// signs, positives closed under products; and copies ranked by `g⁻¹∘h` keep their
-    /// order under every element.
+    /// signs, positives closed under products; and `copy_order` keeps the order of two
+    /// copies under every element.
     fn check_left_order<const D: usize, const N: usize>(m: &FlatManifold<D>, what: &str)
     where
         FlatManifold<D>: OrbitSpace<N, Elem = Motion<D>>,
@@ -1410,6 +1411,13 @@ mod tests {
                 let xy = OrbitSpace::<N>::compose(m, x, y);
                 if sx == Sign::Positive && sign_of(m, y) == Sign::Positive {
                     assert_eq!(sign_of(m, xy), Sign::Positive, "{what}: {x:?}·{y:?}");
+                }
+                let order = m.copy_order(x, y);
+                assert_eq!(order == Sign::Zero, x == y, "{what}");
+                assert_eq!(m.copy_order(y, x), order.flip(), "{what}");
+                for &k in &els[..8] {
+                    let (kx, ky) = (m.compose_elems(k, x), m.compose_elems(k, y));
+                    assert_eq!(m.copy_order(kx, ky), order, "{what}: moved by {k:?}");
                 }
             }
         }

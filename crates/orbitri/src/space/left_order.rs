@@ -15,8 +15,8 @@
 //! space. An element is positive when its first non-zero value along the chain is. This
 //! order exists for every closed flat manifold of positive first Betti number: the Klein
 //! bottle, and every flat 3-manifold but the Hantzsche–Wendt space (the didicosm), whose
-//! group is not left-orderable (Boyer, Rolfsen and Wiest). There the copies keep an order by
-//! lifted position, which translations respect.
+//! group is not left-orderable (Boyer, Rolfsen and Wiest). There the copies are ordered by
+//! coset, then by the translation between them (`FlatManifold::copy_order`).
 
 use crate::predicates::Sign;
 
@@ -66,8 +66,8 @@ impl<const D: usize> LeftOrder<D> {
     /// translation in units of `M/q`), the identity's first; `None` when no chain of
     /// fixed columns spans the space (the group is not left-orderable).
     ///
-    /// Fixed columns are sought among the integer columns of entries in `[-2, 2]`, and an
-    /// element of a kernel among the translations by offsets in `[-3, 3]`: ample for the
+    /// Fixed columns are sought among the integer columns of entries in `[-2, 2]`, and
+    /// whether a coset meets a kernel among its elements of offsets in `[-3, 3]`: ample for the
     /// signed permutations and hexagonal turns of the spaces here (whose fixed spaces have
     /// bases of 0 and ±1); the tests check the order's axioms on every space.
     pub(super) fn new(cosets: &[([[i32; D]; D], [i32; D])], q: i32) -> Option<Self> {

@@ -61,8 +61,9 @@ pub trait OrbitSpace<const N: usize>: Sync + Send {
     fn orient(&self, s: &[Lifted<Self::Point, Self::Elem>; N]) -> Sign;
     /// Exact, symbolically perturbed in-sphere test: `Positive` when `q` is inside the
     /// circumsphere of the positively oriented `s`, never `Zero` for a point distinct from
-    /// the vertices. The perturbation depends only on the lifted positions, so every
-    /// periodic copy of a configuration gets the same answer.
+    /// the vertices. The perturbation is invariant under the group (a torus's lexicographic
+    /// order of lifted positions; a manifold's order of points and of copies by the group's
+    /// left order), so every copy of a configuration gets the same answer.
     fn in_sphere(
         &self,
         s: &[Lifted<Self::Point, Self::Elem>; N],
@@ -137,10 +138,8 @@ pub trait OrbitSpace<const N: usize>: Sync + Send {
     /// False when no element can reverse orientation, known at compile time: the engine then
     /// drops the slot bookkeeping of [`OrbitSpace::normalize`]'s reversals (a torus's path).
     const MAY_REVERSE: bool = true;
-    /// True when every element is a translation (a torus). Otherwise a covering's
-    /// triangulation is equivariant under the whole group only once the quotient's criterion
-    /// holds (its ties between copies of one point are broken by an order invariant under
-    /// translations alone), and the engine moves to the quotient only then.
+    /// True when every element is a translation (a torus). Otherwise the engine moves to the
+    /// quotient only once its criterion holds (`try_one_sheet`'s shortcut is the tori's).
     fn translations_only(&self) -> bool {
         true
     }
