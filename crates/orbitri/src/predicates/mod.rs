@@ -12,6 +12,7 @@
 
 pub mod exact;
 pub mod filter;
+pub mod spherical;
 
 /// The sign of a predicate.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -41,4 +42,38 @@ impl From<std::cmp::Ordering> for Sign {
             std::cmp::Ordering::Greater => Sign::Positive,
         }
     }
+}
+
+/// The symbolic perturbation of a cospherical in-sphere test for a given order of the
+/// points (lifted points of a flat space, or points of the sphere) (`compare(a, b)` on indices, `N` meaning the query): from the largest down,
+/// the first non-zero coefficient of the perturbed determinant, the orientation of `s` with
+/// that point replaced by `q`. The order must be invariant under the group of the space, so
+/// that every copy of a configuration gets the same answer.
+pub(crate) fn perturbed_by<T: Copy, const N: usize>(
+    s: &[T; N],
+    q: T,
+    orient: impl Fn(&[T; N]) -> Sign,
+    compare: impl Fn(usize, usize) -> Sign,
+) -> Sign {
+    let mut order: Vec<usize> = (0..=N).collect();
+    for i in 1..=N {
+        let mut j = i;
+        while j > 0 && compare(order[j - 1], order[j]) == Sign::Positive {
+            order.swap(j - 1, j);
+            j -= 1;
+        }
+    }
+    for &idx in order.iter().rev() {
+        if idx == N {
+            // the query's own coefficient is the orientation of `s`: positive
+            return Sign::Negative;
+        }
+        let mut t = *s;
+        t[idx] = q;
+        let o = orient(&t);
+        if o != Sign::Zero {
+            return o;
+        }
+    }
+    unreachable!("the order holds the query, whose coefficient is never zero")
 }

@@ -16,12 +16,13 @@
 //! The covering ladder is the torus of `T`'s ladder (`k` sheets per torus sheet) followed by
 //! the manifold itself: Caroli–Teillaud's Theorem 10 with the translational subgroup.
 
-use super::flat_torus::{perturbed_by, UnperturbedInSphere, L};
+use super::flat_torus::{UnperturbedInSphere, L};
 use super::lattice::{Ladder, Level};
 use super::left_order::LeftOrder;
 use super::metric::Gram;
 use super::{least_frame, FlatSpace, FlatTorus, Lattice, OrbitSpace};
 use crate::error::{Error, Result};
+use crate::predicates::perturbed_by;
 use crate::predicates::Sign;
 
 /// A group element `x ↦ A_c·x + (s_c/q + o)·M`: coset `coset` of the translations, lattice

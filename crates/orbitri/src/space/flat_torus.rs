@@ -311,7 +311,7 @@ impl<const D: usize> FlatTorus<D> {
         orient: impl Fn(&[L<D>; N]) -> Sign,
     ) -> Sign {
         let at = |k: usize| if k == N { q } else { s[k] };
-        perturbed_by(s, q, orient, |a, b| self.compare_lifted(at(a), at(b)))
+        crate::predicates::perturbed_by(s, q, orient, |a, b| self.compare_lifted(at(a), at(b)))
     }
 
     #[inline]
@@ -416,40 +416,6 @@ impl<const D: usize> FlatTorus<D> {
         let scale = (1u64 << bits) as f64;
         f.map(|v| ((v.clamp(0.0, 1.0) * scale) as u64).min((1 << bits) - 1) as u32)
     }
-}
-
-/// The symbolic perturbation of a cospherical in-sphere test for a given order of the
-/// lifted points (`compare(a, b)` on indices, `N` meaning the query): from the largest down,
-/// the first non-zero coefficient of the perturbed determinant, the orientation of `s` with
-/// that point replaced by `q`. The order must be invariant under the group of the space, so
-/// that every copy of a configuration gets the same answer.
-pub(super) fn perturbed_by<const D: usize, const N: usize>(
-    s: &[L<D>; N],
-    q: L<D>,
-    orient: impl Fn(&[L<D>; N]) -> Sign,
-    compare: impl Fn(usize, usize) -> Sign,
-) -> Sign {
-    let mut order: Vec<usize> = (0..=N).collect();
-    for i in 1..=N {
-        let mut j = i;
-        while j > 0 && compare(order[j - 1], order[j]) == Sign::Positive {
-            order.swap(j - 1, j);
-            j -= 1;
-        }
-    }
-    for &idx in order.iter().rev() {
-        if idx == N {
-            // the query's own coefficient is the orientation of `s`: positive
-            return Sign::Negative;
-        }
-        let mut t = *s;
-        t[idx] = q;
-        let o = orient(&t);
-        if o != Sign::Zero {
-            return o;
-        }
-    }
-    unreachable!("the order holds the query, whose coefficient is never zero")
 }
 
 /// The unperturbed in-sphere sign of a lifted simplex (`Zero` when cospherical), exact: for

@@ -1,0 +1,174 @@
+//! Predicates on the sphere (thesis §4.3.1), for points given in `E³` near the unit sphere:
+//! a spherical triangle `abc` is positively oriented when `det[a; b; c] > 0` (counter-clockwise
+//! seen from outside), and `q` lies inside its circumcircle when `q` and the origin are on
+//! different sides of the plane through `a, b, c`. The triangles are the faces of the convex
+//! hull of the points: the spherical Delaunay triangulation for points on one sphere, the
+//! regular triangulation on the sphere for points near it. Exact for all doubles: the
+//! floating-point filter of [`filter::orient3`], then big integers. Ties (four points on one
+//! plane) are broken by pulling every point towards the origin by an infinitesimal, the
+//! larger the later the point comes in a given order ([`in_circle`]).
+
+use super::exact::{self, Scaled};
+use super::filter;
+use super::{perturbed_by, Sign};
+
+/// Largest absolute coordinate of each row (the filter's bounds).
+fn bounds<const K: usize>(rows: &[[f64; 3]; K]) -> [f64; K] {
+    rows.map(|r| r.iter().fold(0.0f64, |m, x| m.max(x.abs())))
+}
+
+/// `det[a; b; c]` exactly: the orientation of `a, b, c` about the origin.
+pub fn orient_origin(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> Sign {
+    let rows = [*a, *b, *c];
+    if let Some(s) = filter::orient3(&rows, bounds(&rows)) {
+        return s;
+    }
+    let scale = Scaled::new(rows.iter().flatten().copied());
+    let ints = rows.map(|r| r.map(|x| scale.int(x)));
+    exact::sign(&exact::det3(&ints[0], &ints[1], &ints[2]))
+}
+
+/// The side of `q` of the plane through `a, b, c` (positively oriented): `Positive` when
+/// `q` is inside their circumcircle on the sphere (away from the origin), `Zero` on it.
+pub fn side_of_circle(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3], q: &[f64; 3]) -> Sign {
+    // det[b − a; c − a; q − a] is −det[a; b; c] at the origin: q and the origin are on
+    // different sides exactly when it is positive
+    let (d0, b0) = filter::plain_diff(b, a);
+    let (d1, b1) = filter::plain_diff(c, a);
+    let (d2, b2) = filter::plain_diff(q, a);
+    if let Some(s) = filter::orient3(&[d0, d1, d2], [b0, b1, b2]) {
+        return s;
+    }
+    let scale = Scaled::new(a.iter().chain(b).chain(c).chain(q).copied());
+    let ia = a.map(|x| scale.int(x));
+    let diff = |p: &[f64; 3]| -> [num_bigint::BigInt; 3] {
+        std::array::from_fn(|k| scale.int(p[k]) - &ia[k])
+    };
+    exact::sign(&exact::det3(&diff(b), &diff(c), &diff(q)))
+}
+
+/// The perturbed in-circle test of `q` against the positively oriented triangle `s`:
+/// [`side_of_circle`], and on a tie the sign of the determinant once every point `p` is
+/// replaced by `(1 − ε_p)·p`, with `ε_p` infinitesimal and larger for later points of the
+/// order `compare` (on indices, `3` meaning `q`). Never `Zero` for four distinct points
+/// with `s` positively oriented. Pulling `p` in by `ε_p` adds `ε_p` times the orientation
+/// of the other three about the origin to the determinant, the same terms as the lifting
+/// perturbation of a flat space ([`perturbed_by`]).
+pub fn in_circle(s: &[[f64; 3]; 3], q: [f64; 3], compare: impl Fn(usize, usize) -> Sign) -> Sign {
+    match side_of_circle(&s[0], &s[1], &s[2], &q) {
+        Sign::Zero => perturbed_by(s, q, |t| orient_origin(&t[0], &t[1], &t[2]), compare),
+        decided => decided,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use num_bigint::BigInt;
+    use num_rational::BigRational;
+    use num_traits::{One, Signed};
+
+    type Q = BigRational;
+
+    fn q(x: f64) -> Q {
+        BigRational::from_float(x).unwrap()
+    }
+
+    fn det3(m: &[[Q; 3]; 3]) -> Q {
+        &m[0][0] * (&m[1][1] * &m[2][2] - &m[1][2] * &m[2][1])
+            - &m[0][1] * (&m[1][0] * &m[2][2] - &m[1][2] * &m[2][0])
+            + &m[0][2] * (&m[1][0] * &m[2][1] - &m[1][1] * &m[2][0])
+    }
+
+    fn sign(x: &Q) -> Sign {
+        if x.is_positive() {
+            Sign::Positive
+        } else if x.is_negative() {
+            Sign::Negative
+        } else {
+            Sign::Zero
+        }
+    }
+
+    /// An independent evaluation: `det[b'−a'; c'−a'; q'−a']` in rationals, with each point
+    /// shrunk by `1 − ε^(4−k)` for its rank `k` (the last point pulled in the most), `ε`
+    /// small enough that the lowest non-zero order decides.
+    fn explicit(s: &[[f64; 3]; 3], x: [f64; 3], rank: [usize; 4]) -> Sign {
+        let eps = Q::new(BigInt::one(), BigInt::from(1u64) << 200usize);
+        let pts = [s[0], s[1], s[2], x];
+        let shrunk: Vec<[Q; 3]> = pts
+            .iter()
+            .enumerate()
+            .map(|(i, p)| {
+                let mut f = Q::one();
+                for _ in rank[i]..4 {
+                    f *= &eps;
+                }
+                let l = Q::one() - f;
+                p.map(|c| &l * q(c))
+            })
+            .collect();
+        let d = |k: usize| -> [Q; 3] { std::array::from_fn(|c| &shrunk[k][c] - &shrunk[0][c]) };
+        sign(&det3(&[d(1), d(2), d(3)]))
+    }
+
+    #[test]
+    fn orientation_and_side_agree_with_rationals() {
+        let mut r = crate::sort::SplitMix::new(3);
+        for scale in [1.0, 1e-150, 1e150] {
+            for _ in 0..2000 {
+                let mut p = || [r.unit() - 0.5, r.unit() - 0.5, r.unit() - 0.5].map(|x| x * scale);
+                let (a, b, c, x) = (p(), p(), p(), p());
+                let m = [a, b, c].map(|v| v.map(q));
+                assert_eq!(orient_origin(&a, &b, &c), sign(&det3(&m)));
+                let d = [b, c, x].map(|v| std::array::from_fn(|k| q(v[k]) - q(a[k])));
+                assert_eq!(side_of_circle(&a, &b, &c, &x), sign(&det3(&d)));
+            }
+        }
+    }
+
+    #[test]
+    fn ties_match_the_explicit_shrinking() {
+        // points on one plane z = 0.6 (the same double: coplanar exactly), near the sphere
+        let ring: Vec<[f64; 3]> = [
+            (0.8, 0.0),
+            (0.0, 0.8),
+            (-0.8, 0.0),
+            (0.0, -0.8),
+            (0.48, 0.64),
+        ]
+        .iter()
+        .map(|&(x, y)| [x, y, 0.6])
+        .chain([[0.8, 0.0, 0.0], [0.0, 0.8, 0.0], [-0.6, -0.64, 0.0]])
+        .collect();
+        let (mut checked, mut ties) = (0, 0);
+        for i in 0..ring.len() {
+            for j in 0..ring.len() {
+                for k in 0..ring.len() {
+                    for l in 0..ring.len() {
+                        let ids = [i, j, k, l];
+                        if (0..4).any(|u| (u + 1..4).any(|v| ids[u] == ids[v])) {
+                            continue;
+                        }
+                        let s = [ring[i], ring[j], ring[k]];
+                        if orient_origin(&s[0], &s[1], &s[2]) != Sign::Positive {
+                            continue;
+                        }
+                        let x = ring[l];
+                        ties += usize::from(side_of_circle(&s[0], &s[1], &s[2], &x) == Sign::Zero);
+                        let got = in_circle(&s, x, |a, b| Sign::from(ids[a].cmp(&ids[b])));
+                        // ranks: the order of the input indices
+                        let mut rank = [0; 4];
+                        for u in 0..4 {
+                            rank[u] = (0..4).filter(|&v| ids[v] < ids[u]).count();
+                        }
+                        assert_eq!(got, explicit(&s, x, rank), "{ids:?}");
+                        assert_ne!(got, Sign::Zero);
+                        checked += 1;
+                    }
+                }
+            }
+        }
+        assert!(checked > 200 && ties > 50, "{checked} tests, {ties} ties");
+    }
+}
