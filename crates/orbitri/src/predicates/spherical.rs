@@ -53,7 +53,7 @@ pub fn side_of_circle(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3], q: &[f64; 3]) ->
 /// order `compare` (on indices, `3` meaning `q`). Never `Zero` for four distinct points
 /// with `s` positively oriented. Pulling `p` in by `ε_p` adds `ε_p` times the orientation
 /// of the other three about the origin to the determinant, the same terms as the lifting
-/// perturbation of a flat space ([`perturbed_by`]).
+/// perturbation of a flat space (the same loop, `perturbed_by`).
 pub fn in_circle(s: &[[f64; 3]; 3], q: [f64; 3], compare: impl Fn(usize, usize) -> Sign) -> Sign {
     match side_of_circle(&s[0], &s[1], &s[2], &q) {
         Sign::Zero => perturbed_by(s, q, |t| orient_origin(&t[0], &t[1], &t[2]), compare),
