@@ -7,6 +7,8 @@
 
 use std::collections::HashMap;
 
+use rayon::prelude::*;
+
 use super::{CellView, Triangulation};
 use crate::error::{Error, Result};
 use crate::ids::CellId;
@@ -117,28 +119,35 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
                 sheets: self.sheets(),
             });
         }
-        let rows = orbits.representatives.len();
+        // one row per representative, independent of the others: in parallel, in order
+        let rows: Vec<_> = orbits
+            .representatives
+            .par_iter()
+            .map(|&c| {
+                let cell = engine.cell(c);
+                let mut neighbors = [0; N];
+                let mut mirrors = [0; N];
+                let mut gluings = [space.identity(); N];
+                for i in 0..N {
+                    let d = cell.n[i];
+                    let (row, g, slots) = orbits.of[d.index()];
+                    let j = engine.cell(d).mirror(c).expect("neighbours see each other");
+                    neighbors[i] = row;
+                    mirrors[i] = slots[j];
+                    // d's frame onto c's, after the representative's onto d's
+                    gluings[i] = space.compose(engine.translation(c, i, d), g);
+                }
+                (self.view(c), neighbors, mirrors, gluings)
+            })
+            .collect();
         let mut out = Complex {
-            cells: Vec::with_capacity(rows),
-            neighbors: Vec::with_capacity(rows),
-            mirrors: Vec::with_capacity(rows),
-            gluings: Vec::with_capacity(rows),
+            cells: Vec::with_capacity(rows.len()),
+            neighbors: Vec::with_capacity(rows.len()),
+            mirrors: Vec::with_capacity(rows.len()),
+            gluings: Vec::with_capacity(rows.len()),
         };
-        for &c in &orbits.representatives {
-            let cell = engine.cell(c);
-            let mut neighbors = [0; N];
-            let mut mirrors = [0; N];
-            let mut gluings = [space.identity(); N];
-            for i in 0..N {
-                let d = cell.n[i];
-                let (row, g, slots) = orbits.of[d.index()];
-                let j = engine.cell(d).mirror(c).expect("neighbours see each other");
-                neighbors[i] = row;
-                mirrors[i] = slots[j];
-                // d's frame onto c's, after the representative's onto d's
-                gluings[i] = space.compose(engine.translation(c, i, d), g);
-            }
-            out.cells.push(self.view(c));
+        for (cell, neighbors, mirrors, gluings) in rows {
+            out.cells.push(cell);
             out.neighbors.push(neighbors);
             out.mirrors.push(mirrors);
             out.gluings.push(gluings);
