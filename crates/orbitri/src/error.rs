@@ -19,6 +19,17 @@ pub enum Error {
         "the domain's volume, about 2^{log2:.0}, is outside the range of doubles: its Voronoi volumes cannot be represented (rescale the coordinates)"
     )]
     UnrepresentableVolume { log2: f64 },
+    /// A point given as on the unit sphere that is not, within
+    /// [`crate::spherical::NORM_TOLERANCE`] (or a zero vector to normalize).
+    #[error(
+        "point {index}: its norm is {norm}, not 1: points on the sphere must be unit vectors (to within 1e-6), or give them as longitude and latitude, or normalize them"
+    )]
+    OffSphere { index: usize, norm: f64 },
+    /// A spherical Voronoi diagram asked of points that do not enclose the centre.
+    #[error(
+        "the {points} points lie in one closed hemisphere (the triangulation has dimension {dimension}, or faces turn their outer side to the centre): their Voronoi cells are not bounded by the faces alone"
+    )]
+    Hemisphere { points: usize, dimension: i32 },
     #[error("the input holds no points")]
     EmptyInput,
     #[error("invalid box: {0}")]

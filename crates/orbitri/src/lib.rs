@@ -32,6 +32,7 @@ pub mod io;
 pub mod predicates;
 pub mod sort;
 pub mod space;
+pub mod spherical;
 pub mod tds;
 pub mod triangulation;
 pub mod voronoi;
@@ -41,8 +42,9 @@ pub use error::{Error, Result};
 pub use ids::{CellId, InputId, PointId, VertexId};
 pub use space::{
     Coset, FlatManifold, FlatSpace, FlatTorus, FlatTorus2, FlatTorus3, Ladder, Lattice, Motion,
-    OrbitSpace,
+    OrbitSpace, Sphere,
 };
+pub use spherical::{SphericalCell, SphericalDelaunay};
 pub use triangulation::{
     BuildOptions, CellView, Complex, Copies, DelaunayEdge, KleinTriangulation,
     ManifoldTriangulation3, PeriodicDelaunay, PeriodicDelaunay2, PeriodicDelaunay3, Simplex,

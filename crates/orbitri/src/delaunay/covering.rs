@@ -110,6 +110,40 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.commit(&cells);
     }
 
+    /// The level-0 triangulation of the anchors alone ([`OrbitSpace::anchor_cells`]), then
+    /// down the ladder as far as it goes.
+    pub(super) fn install_anchors(&mut self) {
+        self.points = self.space.anchors();
+        self.tds.clear();
+        self.guaranteed = false;
+        self.enter_level(0);
+        let mut facets: HashMap<[VertexId; N], (CellId, usize)> = HashMap::new();
+        for lifted in self.space.anchor_cells() {
+            let mut v = lifted.map(|(p, o)| self.vertex_id(PointId(p), o));
+            let mut off = lifted.map(|(_, o)| o);
+            let arr = lifted.map(|(p, o)| (self.points[p as usize], o));
+            if self.space.orient(&arr) == crate::predicates::Sign::Negative {
+                v.swap(0, 1);
+                off.swap(0, 1);
+            }
+            let c = self.make_cell(v, off);
+            for i in 0..N {
+                let cell = self.tds.cells[c.index()];
+                let key = super::wrap::facet_key(&cell.v, i);
+                match facets.remove(&key) {
+                    Some((d, j)) => self.link(c, i, d, j),
+                    None => {
+                        facets.insert(key, (c, i));
+                    }
+                }
+            }
+            self.attach(c);
+        }
+        assert!(facets.is_empty(), "the anchor cells close up");
+        self.hint = CellId(0);
+        self.descend();
+    }
+
     /// The level-0 triangulation of the first point.
     pub(super) fn bootstrap_covering(&mut self) {
         self.bootstrap(0);
@@ -155,6 +189,16 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
 
     /// Rebuilds the triangulation of the current points at level 0.
     pub(crate) fn rebuild_in_covering(&mut self) {
+        if self.anchors > 0 {
+            // from the anchors again; the points keep their ids (each was a vertex of a
+            // superset's triangulation: none is hidden)
+            let pts = self.points.split_off(self.anchors);
+            self.clear();
+            for p in pts {
+                self.insert_weighted(p, 0.0);
+            }
+            return;
+        }
         let pts = std::mem::take(&mut self.points);
         let ws = std::mem::take(&mut self.weights);
         let weight = |i: usize| ws.get(i).copied().unwrap_or(0.0);

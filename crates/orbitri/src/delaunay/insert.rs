@@ -189,7 +189,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         // weighted: a vertex of the region on none of its boundary facets is hidden; its
         // vertex then points at no live cell once the new cells are attached
         let first_hidden = scratch.hidden.len();
-        if self.weighted {
+        if self.hides() {
             for &(c, _) in &scratch.conflict {
                 scratch.hidden.extend(self.tds.cells[c.index()].v);
             }
@@ -200,7 +200,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         for &nc in &scratch.created {
             self.attach(nc);
         }
-        if self.weighted {
+        if self.hides() {
             let mut k = first_hidden;
             for j in first_hidden..scratch.hidden.len() {
                 let v = scratch.hidden[j];
@@ -277,7 +277,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 }
             }
         }
-        if self.weighted && !self.cell_conflicts(c, (q.0, qo), wq) {
+        if self.hides() && !self.cell_conflicts(c, (q.0, qo), wq) {
             self.hint = c;
             self.hint_shift = self.space.carry(q.1, qo);
             return Err(Refused::Hidden);
@@ -319,10 +319,17 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         gone.sort_unstable_by(|a, b| b.cmp(a));
         gone.dedup();
         for p in gone {
+            if p.index() < self.anchors {
+                // an anchor is only marked (all its copies, hidden together by symmetry): it
+                // comes back when the points stop enclosing it
+                let sheets = self.space.sheets(self.level);
+                self.vcell[p.index() * sheets..(p.index() + 1) * sheets].fill(CellId::NONE);
+                continue;
+            }
             self.hidden_log.push(HiddenPoint {
                 id: p,
                 point: self.points[p.index()],
-                weight: self.weights[p.index()],
+                weight: self.weights.get(p.index()).copied().unwrap_or(0.0),
             });
             let last = PointId::new(self.points.len() - 1);
             self.renumber_last_point(p);

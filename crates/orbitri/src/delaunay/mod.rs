@@ -93,6 +93,9 @@ pub struct Engine<S: OrbitSpace<N>, const N: usize> {
     /// least weight `w` (thesis Lemma 2.3.10), so `|z − p_0|² + W − w_0` plays the squared
     /// circumradius in the switch criterion (see [`Self::radius2`]).
     pub(crate) weight_max: f64,
+    /// The number of anchors of the space ([`OrbitSpace::anchors`]): points `0..anchors`,
+    /// never renumbered, whose vertices are only marked (no cell) while hidden.
+    pub(crate) anchors: usize,
     /// Weighted: the points the insertions since the caller last looked hid, in order.
     pub(crate) hidden_log: Vec<HiddenPoint<S::Point>>,
     /// Vertex → its point (1-sheeted: the identity; covering: one vertex per copy).
@@ -134,6 +137,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// An empty triangulation of the space.
     pub fn new(space: S) -> Self {
         let mut e = Engine {
+            anchors: space.anchors().len(),
             hint_shift: space.identity(),
             copies: Vec::new(),
             big_limit: 0.0,
@@ -181,6 +185,26 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.hint = CellId(0);
         self.hint_shift = self.space.identity();
         self.copy_hints.clear();
+        if self.anchors > 0 {
+            self.install_anchors();
+        }
+    }
+
+    /// True when an insertion may hide points: a regular triangulation, or a space whose
+    /// points need not all be vertices ([`OrbitSpace::HIDES`]).
+    #[inline(always)]
+    pub(crate) fn hides(&self) -> bool {
+        self.weighted || S::HIDES
+    }
+
+    /// The number of points other than the anchors.
+    pub fn number_of_points(&self) -> usize {
+        self.points.len() - self.anchors
+    }
+
+    /// True when point `p` is an anchor that is hidden (has no vertex in any cell).
+    pub fn is_hidden_anchor(&self, p: PointId) -> bool {
+        p.index() < self.anchors && self.vcell[self.vertex_of_point(p).index()] == CellId::NONE
     }
 
     /// An empty regular (weighted Delaunay) triangulation of the space: points come with

@@ -56,7 +56,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// point ids stay `0..n`; the result is the Delaunay triangulation of the remaining
     /// points, the same whatever the history (the perturbation makes it unique).
     pub fn remove_point(&mut self, p: PointId) -> Removal {
-        if self.points.len() == 1 {
+        if self.points.len() == self.anchors + 1 {
             self.clear();
             return Removal::InPlace;
         }
@@ -80,7 +80,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// whether the remaining points had to be triangulated again.
     pub fn remove_points(&mut self, ps: &[PointId]) -> (Vec<PointId>, bool) {
         let n = self.points.len();
-        if ps.len() == n {
+        if ps.len() == n - self.anchors {
             self.clear();
             return (vec![PointId::NONE; n], false);
         }
@@ -150,11 +150,11 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             return Moved::Coordinates;
         }
         let v = self.vertex_of_point(p);
-        // (a weighted move may hide points or uncover hidden ones: the caller removes and
-        // inserts)
-        if self.weighted
+        // (a move that may hide points or uncover hidden ones is left to the caller, who
+        // removes and inserts)
+        if self.hides()
             || !self.one_sheeted
-            || self.points.len() == 1
+            || self.points.len() == self.anchors + 1
             || self.remove_vertex(v).is_err()
         {
             return Moved::Refused;
@@ -179,7 +179,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 self.rebuild_in_covering();
                 Moved::Rebuilt
             }
-            Err(Refused::Hidden) => unreachable!("only weighted points are hidden"),
+            Err(Refused::Hidden) => unreachable!("a space that hides points never gets here"),
         }
     }
 
@@ -190,7 +190,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// star then stays a star-shaped triangulation around `to`, so `to` meets no other
     /// point. Returns false, with nothing changed, otherwise (then remove and insert).
     pub fn try_move(&mut self, p: PointId, to: S::Point) -> bool {
-        if !(self.one_sheeted && self.guaranteed) || self.weighted {
+        if !(self.one_sheeted && self.guaranteed) || self.hides() {
             return false;
         }
         let v = self.vertex_of_point(p);

@@ -73,7 +73,13 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 }
             }
         }
+        let sheets = self.sheets();
+        let mut hidden = 0;
         for (v, &c) in self.vcell.iter().enumerate() {
+            if c == CellId::NONE && v / sheets < self.anchors {
+                hidden += 1;
+                continue;
+            }
             if c == CellId::NONE
                 || !self.tds.is_alive(c)
                 || self.tds.cells[c.index()]
@@ -83,15 +89,16 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 return bad(format!("vertex {v} has no incident cell"));
             }
         }
-        // The Euler characteristic of the stored complex: the space's, times the sheets of a
-        // covering. Every facet is shared by two cells (checked above), so F = 2C in 3D and
+        // The Euler characteristic of the stored complex (hidden anchors aside): the space's,
+        // times the sheets of a covering. Every facet is shared by two cells (checked above), so F = 2C in 3D and
         // the faces are the cells in 2D: in both, χ = V − E + C. Edges are counted from each vertex's star, towards larger ids (in
         // the covering, ids are unique per copy, so an edge is one (vertex, vertex) pair).
         let edges: usize = (0..self.vcell.len() as u32)
             .map(VertexId)
+            .filter(|v| self.vcell[v.index()] != CellId::NONE)
             .map(|v| self.neighbours(v).iter().filter(|w| w.0 > v).count())
             .sum();
-        let counts = [self.vcell.len(), edges, self.tds.len()];
+        let counts = [self.vcell.len() - hidden, edges, self.tds.len()];
         let euler = counts[0] as i64 - counts[1] as i64 + counts[2] as i64;
         let expected = self.sheets() as i64 * self.space.euler_characteristic();
         if euler != expected {

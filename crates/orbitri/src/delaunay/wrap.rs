@@ -42,7 +42,7 @@ pub(super) struct Wrapped<P, O, const N: usize> {
     pub links: [Option<Owner>; N],
 }
 
-fn facet_key<const N: usize>(vids: &[VertexId; N], skip: usize) -> [VertexId; N] {
+pub(super) fn facet_key<const N: usize>(vids: &[VertexId; N], skip: usize) -> [VertexId; N] {
     let mut k = *vids;
     k[skip] = VertexId::NONE;
     k.sort_unstable();

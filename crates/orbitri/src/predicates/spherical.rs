@@ -17,12 +17,35 @@ fn bounds<const K: usize>(rows: &[[f64; 3]; K]) -> [f64; K] {
     rows.map(|r| r.iter().fold(0.0f64, |m, x| m.max(x.abs())))
 }
 
-/// `det[a; b; c]` exactly: the orientation of `a, b, c` about the origin.
+/// Coordinates of an anchor: `t·2⁻¹⁰⁰⁰` for a small integer vector `t`, standing for `δ·t`
+/// with `δ` infinitesimal (no point near the unit sphere comes close).
+pub const ANCHOR_SCALE: f64 = f64::from_bits((1023 - 1000) << 52);
+
+/// True for an anchor: every coordinate below `2⁻⁹⁰⁰` in magnitude.
+#[inline]
+pub fn is_anchor(p: &[f64; 3]) -> bool {
+    p.iter()
+        .all(|x| x.abs() < f64::from_bits((1023 - 900) << 52))
+}
+
+/// The direction of a point: an anchor scaled up by `2¹⁰⁰⁰` (exactly), others as they are.
+/// Orientations about the origin keep their sign.
+fn direction(p: &[f64; 3]) -> [f64; 3] {
+    if is_anchor(p) {
+        p.map(|x| x / ANCHOR_SCALE)
+    } else {
+        *p
+    }
+}
+
+/// `det[a; b; c]` exactly: the orientation of `a, b, c` about the origin (an anchor counts
+/// by its direction).
 pub fn orient_origin(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> Sign {
     let rows = [*a, *b, *c];
     if let Some(s) = filter::orient3(&rows, bounds(&rows)) {
         return s;
     }
+    let rows = rows.map(|r| direction(&r));
     let scale = Scaled::new(rows.iter().flatten().copied());
     let ints = rows.map(|r| r.map(|x| scale.int(x)));
     exact::sign(&exact::det3(&ints[0], &ints[1], &ints[2]))
@@ -30,6 +53,8 @@ pub fn orient_origin(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> Sign {
 
 /// The side of `q` of the plane through `a, b, c` (positively oriented): `Positive` when
 /// `q` is inside their circumcircle on the sphere (away from the origin), `Zero` on it.
+/// Anchors are taken symbolically ([`anchored_side`]); when the filter decides, the
+/// infinitesimal terms are below its error bound and cannot change the sign.
 pub fn side_of_circle(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3], q: &[f64; 3]) -> Sign {
     // det[b − a; c − a; q − a] is −det[a; b; c] at the origin: q and the origin are on
     // different sides exactly when it is positive
@@ -39,12 +64,42 @@ pub fn side_of_circle(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3], q: &[f64; 3]) ->
     if let Some(s) = filter::orient3(&[d0, d1, d2], [b0, b1, b2]) {
         return s;
     }
+    if [a, b, c, q].iter().any(|p| is_anchor(p)) {
+        return anchored_side(&[*a, *b, *c, *q]);
+    }
     let scale = Scaled::new(a.iter().chain(b).chain(c).chain(q).copied());
     let ia = a.map(|x| scale.int(x));
     let diff = |p: &[f64; 3]| -> [num_bigint::BigInt; 3] {
         std::array::from_fn(|k| scale.int(p[k]) - &ia[k])
     };
     exact::sign(&exact::det3(&diff(b), &diff(c), &diff(q)))
+}
+
+/// [`side_of_circle`] with anchors among the points, exactly: the determinant
+/// `det[b − a; c − a; q − a] = det[b; c; q] − det[a; c; q] + det[a; b; q] − det[a; b; c]` is a
+/// polynomial in `δ`, each term of the order of its number of anchors; its sign is that of
+/// the lowest order whose terms do not cancel (`Zero` when all do).
+fn anchored_side(rows: &[[f64; 3]; 4]) -> Sign {
+    let anchor = rows.map(|r| is_anchor(&r));
+    let dirs = rows.map(|r| direction(&r));
+    let scale = Scaled::new(dirs.iter().flatten().copied());
+    let ints = dirs.map(|r| r.map(|x| scale.int(x)));
+    let mut orders: [num_bigint::BigInt; 4] = Default::default();
+    for k in 0..4 {
+        let o: Vec<usize> = (0..4).filter(|&i| i != k).collect();
+        let m = o.iter().filter(|&&i| anchor[i]).count();
+        let d = exact::det3(&ints[o[0]], &ints[o[1]], &ints[o[2]]);
+        if k % 2 == 0 {
+            orders[m] += d;
+        } else {
+            orders[m] -= d;
+        }
+    }
+    orders
+        .iter()
+        .map(exact::sign)
+        .find(|&s| s != Sign::Zero)
+        .unwrap_or(Sign::Zero)
 }
 
 /// The perturbed in-circle test of `q` against the positively oriented triangle `s`:
@@ -125,6 +180,64 @@ mod tests {
                 assert_eq!(side_of_circle(&a, &b, &c, &x), sign(&det3(&d)));
             }
         }
+    }
+
+    /// `det[b − a; c − a; q − a]` in rationals with anchors at `2⁻ᵏ·t` for a given `k`.
+    fn with_delta(rows: &[[f64; 3]; 4], k: usize) -> Sign {
+        let delta = Q::new(BigInt::one(), BigInt::from(1u64) << k);
+        let pts: Vec<[Q; 3]> = rows
+            .iter()
+            .map(|p| {
+                if is_anchor(p) {
+                    p.map(|x| q(x / ANCHOR_SCALE) * &delta)
+                } else {
+                    p.map(q)
+                }
+            })
+            .collect();
+        let d = |i: usize| -> [Q; 3] { std::array::from_fn(|c| &pts[i][c] - &pts[0][c]) };
+        sign(&det3(&[d(1), d(2), d(3)]))
+    }
+
+    #[test]
+    fn anchors_are_infinitesimal() {
+        let t = [
+            [1.0, 1.0, 1.0],
+            [1.0, -1.0, -1.0],
+            [-1.0, 1.0, -1.0],
+            [-1.0, -1.0, 1.0],
+        ]
+        .map(|v: [f64; 3]| v.map(|x| x * ANCHOR_SCALE));
+        let mut r = crate::sort::SplitMix::new(9);
+        let mut unit = || {
+            let v = [r.unit() - 0.5, r.unit() - 0.5, r.unit() - 0.5];
+            let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+            v.map(|x| x / n)
+        };
+        let mut decided = 0;
+        for round in 0..3000 {
+            let mut rows = [unit(), unit(), unit(), unit()];
+            // one to three anchors in random slots
+            for k in 0..1 + round % 3 {
+                rows[(round / 3 + k) % 4] = t[(round + k) % 4];
+            }
+            if round % 50 == 0 {
+                // a tie at order zero: three real points on a great circle with an anchor
+                rows = [
+                    t[round % 4],
+                    [1.0, 0.0, 0.0],
+                    [0.0, 1.0, 0.0],
+                    [0.6, -0.8, 0.0],
+                ];
+            }
+            let got = side_of_circle(&rows[0], &rows[1], &rows[2], &rows[3]);
+            assert_eq!(got, with_delta(&rows, 400), "{rows:?}");
+            decided += usize::from(got != Sign::Zero);
+            let o = orient_origin(&rows[0], &rows[1], &rows[2]);
+            let m = [rows[0], rows[1], rows[2]].map(|p| direction(&p).map(q));
+            assert_eq!(o, sign(&det3(&m)));
+        }
+        assert!(decided > 2900);
     }
 
     #[test]

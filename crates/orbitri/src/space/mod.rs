@@ -10,12 +10,14 @@ mod lattice;
 mod left_order;
 mod metric;
 mod platycosms;
+mod sphere;
 mod sublattice;
 
 pub use flat_manifold::{Coset, FlatManifold, Motion};
 pub use flat_torus::{FlatTorus, FlatTorus2, FlatTorus3, Offset3};
 pub(crate) use lattice::ldexp;
 pub use lattice::{Ladder, Lattice, Level, MAX_COPIES, MAX_DEFECT};
+pub use sphere::{pole, Sphere};
 pub use sublattice::Sublattice;
 
 use crate::predicates::Sign;
@@ -175,6 +177,21 @@ pub trait OrbitSpace<const N: usize>: Sync + Send {
     fn spatial_key(&self, p: &Self::Point) -> u64;
     /// The width of [`OrbitSpace::spatial_key`], at most 63.
     const KEY_BITS: u32;
+    /// True when an inserted point need not become a vertex (the sphere's points strictly
+    /// inside the hull of the others): the engine then hides points as for weighted ones.
+    const HIDES: bool = false;
+    /// Symbolic points that every triangulation holds (as points `0..k`) so that even one
+    /// point has a triangulation of level 0: the sphere's infinitesimal tetrahedron around
+    /// the centre. An anchor is hidden, not removed, once the points enclose it. None for
+    /// the flat spaces, whose level 0 triangulates every non-empty point set.
+    fn anchors(&self) -> Vec<Self::Point> {
+        Vec::new()
+    }
+    /// The cells of the level-0 triangulation of the anchors alone: (anchor, element) per
+    /// vertex, in either orientation.
+    fn anchor_cells(&self) -> Vec<[(u32, Self::Elem); N]> {
+        Vec::new()
+    }
 }
 
 /// A flat orbit space as the facade, the Voronoi layer and the writers see it: points

@@ -1,0 +1,275 @@
+//! The sphere S² (thesis §4.3.1) as an orbit space of the engine: the trivial group, cells
+//! are triangles `[f64; 3]³` positively oriented about the centre, and the Delaunay
+//! triangulation is the boundary of the convex hull of the points (the spherical Delaunay
+//! triangulation for points on the unit sphere, the regular triangulation on the sphere for
+//! points near it: a point strictly inside the hull of the others is hidden).
+//!
+//! Four anchors `δ·tᵢ` (a regular tetrahedron shrunk to the centre, `δ` infinitesimal, see
+//! [`spherical::side_of_circle`]) keep the centre strictly inside the hull of any point set,
+//! so that one point, three points or a hemisphere are triangulations too: the cells free
+//! of anchors are exactly the faces of the hull that have the centre strictly on their
+//! inner side (CGAL's solid faces), and an anchor is hidden once the points enclose the
+//! centre.
+
+use super::{Lifted, OrbitSpace};
+use crate::predicates::spherical::{self, ANCHOR_SCALE};
+use crate::predicates::Sign;
+
+/// The unit sphere S².
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Sphere;
+
+/// A lifted point of the sphere (the group is trivial).
+type L = Lifted<[f64; 3], ()>;
+
+/// `(b − a) × (c − a)`.
+fn normal(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> [f64; 3] {
+    let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+    [
+        u[1] * v[2] - u[2] * v[1],
+        u[2] * v[0] - u[0] * v[2],
+        u[0] * v[1] - u[1] * v[0],
+    ]
+}
+
+fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// The pole of the circumcircle of the positively oriented triangle `abc` of points near
+/// the unit sphere: the unit normal of its plane, pointing away from the centre (the
+/// spherical circumcentre, a vertex of the Voronoi diagram). Each coordinate is within a
+/// few units in the last place of the exact unit normal unless the triangle is a sliver.
+pub fn pole(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> [f64; 3] {
+    let n = normal(a, b, c);
+    let len = dot(&n, &n).sqrt();
+    n.map(|x| x / len)
+}
+
+/// The key of a point along a space-filling curve over the sphere: the cube face its
+/// direction passes through (3 bits), then the Hilbert index of its gnomonic coordinates on
+/// that face (30 bits per axis).
+pub(crate) fn sphere_key(p: &[f64; 3]) -> u64 {
+    let a = p.map(f64::abs);
+    let axis = if a[0] >= a[1] && a[0] >= a[2] {
+        0
+    } else if a[1] >= a[2] {
+        1
+    } else {
+        2
+    };
+    let face = 2 * axis as u64 + u64::from(p[axis] < 0.0);
+    let m = a[axis];
+    let cell = |x: f64| -> u32 {
+        let t = ((x / m + 1.0) * 0.5 * (1u64 << 30) as f64) as u64;
+        t.min((1 << 30) - 1) as u32
+    };
+    let h = crate::sort::hilbert::<2>([cell(p[(axis + 1) % 3]), cell(p[(axis + 2) % 3])], 30);
+    (face << 60) | h
+}
+
+/// The regular tetrahedron of the anchors, shrunk to `2⁻¹⁰⁰⁰`.
+const ANCHORS: [[f64; 3]; 4] = [
+    [ANCHOR_SCALE, ANCHOR_SCALE, ANCHOR_SCALE],
+    [ANCHOR_SCALE, -ANCHOR_SCALE, -ANCHOR_SCALE],
+    [-ANCHOR_SCALE, ANCHOR_SCALE, -ANCHOR_SCALE],
+    [-ANCHOR_SCALE, -ANCHOR_SCALE, ANCHOR_SCALE],
+];
+
+impl OrbitSpace<3> for Sphere {
+    type Point = [f64; 3];
+    type Elem = ();
+
+    fn identity(&self) {}
+    fn compose(&self, _: (), _: ()) {}
+    fn inverse(&self, _: ()) {}
+
+    fn euler_characteristic(&self) -> i64 {
+        2
+    }
+
+    fn orient(&self, s: &[L; 3]) -> Sign {
+        spherical::orient_origin(&s[0].0, &s[1].0, &s[2].0)
+    }
+
+    /// Ties are broken by pulling the later points of the lexicographic order of
+    /// coordinates further towards the centre: the same whatever the insertion order.
+    fn in_sphere(&self, s: &[L; 3], q: L) -> Sign {
+        let pts = [s[0].0, s[1].0, s[2].0, q.0];
+        spherical::in_circle(&[pts[0], pts[1], pts[2]], q.0, |i, j| {
+            Sign::from(pts[i].partial_cmp(&pts[j]).expect("finite coordinates"))
+        })
+    }
+
+    fn cospherical(&self, s: &[L; 3], q: L) -> bool {
+        spherical::side_of_circle(&s[0].0, &s[1].0, &s[2].0, &q.0) == Sign::Zero
+    }
+
+    fn coincide(&self, a: L, b: L) -> bool {
+        a.0 == b.0
+    }
+
+    /// The squared chord from the pole of the cell to its vertex 0 (`2 − 2 cos θ` for the
+    /// angular radius `θ`), accurate to about `1e-12` absolute; 4 (the largest) for a cell
+    /// with an anchor.
+    fn circumradius2(&self, s: &[L; 3]) -> f64 {
+        if s.iter().any(|x| spherical::is_anchor(&x.0)) {
+            return 4.0;
+        }
+        let n = pole(&s[0].0, &s[1].0, &s[2].0);
+        let a = s[0].0;
+        let r = dot(&a, &a).sqrt();
+        (2.0 - 2.0 * dot(&n, &a) / r).clamp(0.0, 4.0)
+    }
+
+    /// The sphere carries no weights (its triangulations are never weighted): this is the
+    /// in-circle test, which the power test of equal weights is.
+    fn power_test(&self, s: &[L; 3], ws: &[f64; 3], q: L, wq: f64) -> Sign {
+        debug_assert!(
+            ws.iter().all(|&w| w == wq),
+            "the sphere's points are unweighted"
+        );
+        self.in_sphere(s, q)
+    }
+
+    fn orthogonal(&self, s: &[L; 3], ws: &[f64; 3], q: L, wq: f64) -> bool {
+        debug_assert!(
+            ws.iter().all(|&w| w == wq),
+            "the sphere's points are unweighted"
+        );
+        self.cospherical(s, q)
+    }
+
+    /// The pole of the cell ([`pole`]) relative to vertex 0.
+    fn orthocenter(&self, s: &[L; 3], _: &[f64; 3]) -> [f64; 3] {
+        let n = pole(&s[0].0, &s[1].0, &s[2].0);
+        std::array::from_fn(|k| n[k] - s[0].0[k])
+    }
+
+    fn ortho_distance2(&self, s: &[L; 3], _: &[f64; 3]) -> f64 {
+        self.circumradius2(s)
+    }
+
+    fn levels(&self) -> usize {
+        1
+    }
+
+    fn criterion_radius2(&self, _: usize) -> f64 {
+        f64::INFINITY
+    }
+
+    fn single_lift_radius2(&self) -> f64 {
+        f64::INFINITY
+    }
+
+    fn covering_copies(&self, _: usize) -> Vec<()> {
+        vec![()]
+    }
+
+    const MAY_REVERSE: bool = false;
+
+    fn reverses_orientation(&self, _: ()) -> bool {
+        false
+    }
+
+    fn normalize(&self, _: &mut [(); 3], _: usize) -> bool {
+        false
+    }
+
+    fn dummy_points(&self) -> Vec<[f64; 3]> {
+        Vec::new()
+    }
+
+    fn sheets(&self, _: usize) -> usize {
+        1
+    }
+
+    fn sheet_of(&self, _: (), _: usize) -> usize {
+        0
+    }
+
+    fn near(&self, z: L, pts: &[[f64; 3]], radius: f64, out: &mut Vec<(u32, ())>) {
+        let r2 = radius * radius * (1.0 + 1e-9);
+        for (i, p) in pts.iter().enumerate() {
+            let d = [p[0] - z.0[0], p[1] - z.0[1], p[2] - z.0[2]];
+            if dot(&d, &d) <= r2 {
+                out.push((i as u32, ()));
+            }
+        }
+    }
+
+    fn edge_bound(&self, _: usize) -> f64 {
+        2.0
+    }
+
+    fn spatial_key(&self, p: &[f64; 3]) -> u64 {
+        sphere_key(p)
+    }
+
+    const KEY_BITS: u32 = 63;
+    const HIDES: bool = true;
+
+    fn anchors(&self) -> Vec<[f64; 3]> {
+        ANCHORS.to_vec()
+    }
+
+    fn anchor_cells(&self) -> Vec<[(u32, ()); 3]> {
+        [[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]]
+            .map(|c| c.map(|i| (i, ())))
+            .to_vec()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::delaunay::Engine;
+    use crate::sort::SplitMix;
+
+    fn unit(r: &mut SplitMix) -> [f64; 3] {
+        loop {
+            let v = [
+                r.unit() * 2.0 - 1.0,
+                r.unit() * 2.0 - 1.0,
+                r.unit() * 2.0 - 1.0,
+            ];
+            let n = dot(&v, &v);
+            if n > 0.01 && n <= 1.0 {
+                return v.map(|x| x / n.sqrt());
+            }
+        }
+    }
+
+    #[test]
+    fn anchors_alone_are_a_valid_sphere() {
+        let e = Engine::new(Sphere);
+        e.is_valid().unwrap();
+        assert_eq!(e.number_of_cells(), 4);
+        assert_eq!(e.number_of_points(), 0);
+    }
+
+    #[test]
+    fn random_points_hide_every_anchor() {
+        let mut e = Engine::new(Sphere);
+        let mut r = SplitMix::new(1);
+        for k in 0..500 {
+            e.insert(unit(&mut r));
+            if k < 12 || k % 50 == 0 {
+                e.is_valid().unwrap();
+            }
+        }
+        e.is_valid().unwrap();
+        assert!((0..4).all(|a| e.is_hidden_anchor(crate::ids::PointId(a))));
+        // a triangulated sphere: 2V − 4 faces
+        assert_eq!(e.number_of_cells(), 2 * 500 - 4);
+    }
+
+    #[test]
+    fn keys_follow_the_cube_faces() {
+        assert_eq!(sphere_key(&[1.0, 0.0, 0.0]) >> 60, 0);
+        assert_eq!(sphere_key(&[-1.0, 0.0, 0.0]) >> 60, 1);
+        assert_eq!(sphere_key(&[0.0, 0.0, -1.0]) >> 60, 5);
+        assert!(sphere_key(&[0.0, 0.0, -1.0]) < 1 << 63);
+    }
+}

@@ -1,0 +1,546 @@
+//! `SphericalDelaunay`: the Delaunay triangulation of points on the unit sphere S² (thesis
+//! §4.3.1) on the generic engine ([`crate::space::Sphere`]), with the input bookkeeping
+//! of the sphere: points given as unit vectors or longitude/latitude, duplicates, points
+//! hidden inside the hull of the others, CGAL's `dimension()` for small and flat sets, and
+//! the faces by input ids.
+//!
+//! Semantics, exactly for the doubles given: the faces are those of the convex hull of the
+//! points that have the centre strictly on their inner side (for points on one sphere, the
+//! spherical Delaunay triangulation; otherwise the regular triangulation on the sphere
+//! that CGAL computes). Four points on one circle are separated by a symbolic perturbation
+//! (later points of the lexicographic order pulled further towards the centre), so the
+//! faces never depend on the insertion order. A point strictly inside the hull of the others
+//! (possible only for points off the sphere by rounding) is *hidden*: kept, reported, and a
+//! vertex again when a removal uncovers it.
+
+mod voronoi;
+
+pub use voronoi::SphericalCell;
+
+use std::collections::BTreeMap;
+use std::ops::ControlFlow;
+
+use crate::delaunay::{Engine, Inserted, Invalid};
+use crate::error::{Error, Result};
+use crate::ids::{CellId, InputId, PointId, VertexId};
+use crate::predicates::spherical::{orient_origin, side_of_circle};
+use crate::predicates::Sign;
+use crate::space::{OrbitSpace, Sphere};
+
+/// How far `|p|²` may be from 1 for a point given as on the unit sphere (doubles rarely
+/// are exactly): about single precision, so that a wrong column or unnormalized vectors
+/// are caught, while rounded unit vectors pass.
+pub const NORM_TOLERANCE: f64 = 1.0 / (1u64 << 20) as f64;
+
+/// `input_point` of a hidden input.
+const HIDDEN: PointId = PointId(u32::MAX - 1);
+
+/// What became of an inserted point.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Status {
+    /// A vertex of the triangulation.
+    Vertex,
+    /// It coincides with the point of this earlier input.
+    Duplicate(InputId),
+    /// Strictly inside the hull of the others: no vertex (see the module's semantics).
+    Hidden,
+}
+
+/// The unit vector of a longitude and latitude in degrees: `(cos φ cos λ, cos φ sin λ,
+/// sin φ)`. An error names a non-finite value or a latitude beyond ±90°.
+pub fn lonlat_to_point(index: usize, lon: f64, lat: f64) -> Result<[f64; 3]> {
+    for (axis, v) in [lon, lat].into_iter().enumerate() {
+        if !v.is_finite() {
+            return Err(Error::NonFiniteCoordinate {
+                index,
+                axis,
+                value: v,
+            });
+        }
+    }
+    if lat.abs() > 90.0 {
+        return Err(Error::InvalidOption {
+            option: "latitude",
+            value: format!("{lat} (point {index})"),
+            limit: "must lie within [-90, 90] degrees".into(),
+        });
+    }
+    let (l, f) = (lon.to_radians(), lat.to_radians());
+    // exact poles and equator points where the trigonometry would leave 6e-17
+    let (sf, cf) = match lat {
+        90.0 => (1.0, 0.0),
+        -90.0 => (-1.0, 0.0),
+        0.0 => (0.0, 1.0),
+        _ => f.sin_cos(),
+    };
+    let (sl, cl) = match lon.rem_euclid(90.0) {
+        0.0 => match (lon.rem_euclid(360.0) / 90.0) as u8 {
+            0 => (0.0, 1.0),
+            1 => (1.0, 0.0),
+            2 => (0.0, -1.0),
+            _ => (-1.0, 0.0),
+        },
+        _ => l.sin_cos(),
+    };
+    Ok([cf * cl, cf * sl, sf])
+}
+
+/// The longitude and latitude in degrees of a point of the sphere (longitude in
+/// `(-180, 180]`).
+pub fn point_to_lonlat(p: &[f64; 3]) -> [f64; 2] {
+    let h = p[0].hypot(p[1]);
+    [p[1].atan2(p[0]).to_degrees(), p[2].atan2(h).to_degrees()]
+}
+
+/// Each point moved radially onto the unit sphere (rounded: within a few units in the last
+/// place); an error names a non-finite or zero vector.
+pub fn normalized(points: &[[f64; 3]]) -> Result<Vec<[f64; 3]>> {
+    points
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            check_finite(i, p)?;
+            // (scaled first: no overflow or underflow in the norm)
+            let m = p.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            if m == 0.0 {
+                return Err(Error::OffSphere {
+                    index: i,
+                    norm: 0.0,
+                });
+            }
+            let s = p.map(|x| x / m);
+            let n2 = s.iter().map(|x| x * x).sum::<f64>().sqrt();
+            Ok(s.map(|x| x / n2))
+        })
+        .collect()
+}
+
+fn check_finite(index: usize, p: &[f64; 3]) -> Result<()> {
+    match p.iter().position(|x| !x.is_finite()) {
+        Some(axis) => Err(Error::NonFiniteCoordinate {
+            index,
+            axis,
+            value: p[axis],
+        }),
+        None => Ok(()),
+    }
+}
+
+/// Ok for a point within [`NORM_TOLERANCE`] of the unit sphere, else the error naming it.
+fn check_point(index: usize, p: &[f64; 3]) -> Result<()> {
+    check_finite(index, p)?;
+    let n2 = p[0] * p[0] + p[1] * p[1] + p[2] * p[2];
+    if (n2 - 1.0).abs() > NORM_TOLERANCE {
+        return Err(Error::OffSphere {
+            index,
+            norm: n2.sqrt(),
+        });
+    }
+    Ok(())
+}
+
+/// The Delaunay triangulation of points on the unit sphere.
+#[derive(Debug)]
+pub struct SphericalDelaunay {
+    engine: Engine<Sphere, 3>,
+    /// Input → its point in the engine (`NONE` once removed, [`HIDDEN`]).
+    input_point: Vec<PointId>,
+    /// Engine point → the input id of its first occurrence (`NONE` for the anchors).
+    point_input: Vec<InputId>,
+    /// Inputs that share a point with an earlier one.
+    duplicates: usize,
+    /// The hidden inputs and their points.
+    hidden: BTreeMap<InputId, [f64; 3]>,
+}
+
+impl Default for SphericalDelaunay {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl SphericalDelaunay {
+    /// An empty triangulation.
+    pub fn new() -> Self {
+        let engine = Engine::new(Sphere);
+        let anchors = engine.points().len();
+        SphericalDelaunay {
+            engine,
+            input_point: Vec::new(),
+            point_input: vec![InputId::NONE; anchors],
+            duplicates: 0,
+            hidden: BTreeMap::new(),
+        }
+    }
+
+    /// The triangulation of `points` (unit vectors, each within [`NORM_TOLERANCE`] of the
+    /// sphere; see [`normalized`] for others), inserted in BRIO + Hilbert order.
+    ///
+    /// ```
+    /// use orbitri::spherical::SphericalDelaunay;
+    /// let s = 0.5f64.sqrt();
+    /// let octahedron = [[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0],
+    ///                   [0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0], [s, s, 0.0]];
+    /// let tri = SphericalDelaunay::build(&octahedron).unwrap();
+    /// assert_eq!(tri.dimension(), 2);
+    /// assert_eq!(tri.faces().len(), 2 * 7 - 4);
+    /// assert!(tri.is_valid().is_ok());
+    /// ```
+    pub fn build(points: &[[f64; 3]]) -> Result<Self> {
+        Self::build_with(points, |_| ControlFlow::Continue(()))
+    }
+
+    /// [`Self::build`] of longitudes and latitudes in degrees ([`lonlat_to_point`]).
+    pub fn build_lonlat(lonlat: &[[f64; 2]]) -> Result<Self> {
+        let pts = lonlat
+            .iter()
+            .enumerate()
+            .map(|(i, l)| lonlat_to_point(i, l[0], l[1]))
+            .collect::<Result<Vec<_>>>()?;
+        Self::build(&pts)
+    }
+
+    /// [`Self::build`] with a progress callback, called with the number of points inserted
+    /// so far (before the first, every 4096 points, at the end); [`ControlFlow::Break`]
+    /// stops the construction with [`Error::Interrupted`].
+    pub fn build_with(
+        points: &[[f64; 3]],
+        mut progress: impl FnMut(usize) -> ControlFlow<()>,
+    ) -> Result<Self> {
+        if points.is_empty() {
+            return Err(Error::EmptyInput);
+        }
+        for (i, p) in points.iter().enumerate() {
+            check_point(i, p)?;
+        }
+        let mut tri = Self::new();
+        tri.engine.reserve(points.len() + 4, 2 * points.len() + 8);
+        tri.input_point = vec![PointId::NONE; points.len()];
+        let keys: Vec<u64> = points.iter().map(|p| Sphere.spatial_key(p)).collect();
+        for (k, &i) in crate::sort::brio_order(&keys, 0x0b17).iter().enumerate() {
+            if k % 4096 == 0 && progress(k).is_break() {
+                return Err(Error::Interrupted);
+            }
+            tri.insert_checked(InputId(i), points[i as usize]);
+        }
+        if progress(points.len()).is_break() {
+            return Err(Error::Interrupted);
+        }
+        Ok(tri)
+    }
+
+    /// Inserts one more point (its input id is the number of points given so far).
+    pub fn insert(&mut self, p: [f64; 3]) -> Result<Status> {
+        check_point(self.input_point.len(), &p)?;
+        let i = InputId::new(self.input_point.len());
+        self.input_point.push(PointId::NONE);
+        Ok(self.insert_checked(i, p))
+    }
+
+    /// Inserts input `i` (its slot in `input_point` exists) at the checked point `p`.
+    fn insert_checked(&mut self, i: InputId, p: [f64; 3]) -> Status {
+        match self.engine.insert(p) {
+            Inserted::New(q) => {
+                // the new point came last, then the points it hid left, the last point
+                // taking each one's id: followed here in the same order
+                self.input_point[i.index()] = PointId::new(self.point_input.len());
+                self.point_input.push(i);
+                self.absorb_hidden();
+                debug_assert_eq!(self.input_point[i.index()], q);
+                Status::Vertex
+            }
+            Inserted::Duplicate(q) => {
+                self.input_point[i.index()] = q;
+                self.duplicates += 1;
+                let first = &mut self.point_input[q.index()];
+                *first = (*first).min(i);
+                Status::Duplicate(*first)
+            }
+            Inserted::Hidden => {
+                self.input_point[i.index()] = HIDDEN;
+                self.hidden.insert(i, p);
+                Status::Hidden
+            }
+        }
+    }
+
+    /// The inputs of engine point `p`.
+    fn inputs_of(&self, p: PointId) -> Vec<InputId> {
+        if self.duplicates == 0 {
+            vec![self.point_input[p.index()]]
+        } else {
+            (0..self.input_point.len())
+                .filter(|&j| self.input_point[j] == p)
+                .map(InputId::new)
+                .collect()
+        }
+    }
+
+    /// The points the engine's last insertion hid: their inputs become hidden, and the
+    /// point ids follow the engine's renumbering (the last point takes each one's id).
+    fn absorb_hidden(&mut self) {
+        for h in std::mem::take(&mut self.engine.hidden_log) {
+            let inputs = self.inputs_of(h.id);
+            self.duplicates -= inputs.len() - 1;
+            for j in inputs {
+                self.input_point[j.index()] = HIDDEN;
+                self.hidden.insert(j, h.point);
+            }
+            self.forget_point(h.id);
+        }
+    }
+
+    /// After the engine dropped point `p` and moved its last point into `p`'s slot.
+    fn forget_point(&mut self, p: PointId) {
+        let last = PointId::new(self.point_input.len() - 1);
+        let moved = self.inputs_of(last);
+        self.point_input.swap_remove(p.index());
+        if p != last {
+            for j in moved {
+                self.input_point[j.index()] = p;
+            }
+        }
+    }
+
+    /// Removes input `i`; the others keep their ids. Hidden points that the removal
+    /// uncovers become vertices. An unknown or removed id is an error that changes nothing.
+    pub fn remove(&mut self, i: InputId) -> Result<()> {
+        let p = match self.input_point.get(i.index()) {
+            None => {
+                return Err(Error::UnknownInput {
+                    id: i.0 as u64,
+                    why: format!(
+                        "out of range ({} input points were given)",
+                        self.input_point.len()
+                    ),
+                })
+            }
+            Some(&p) if p == PointId::NONE => {
+                return Err(Error::UnknownInput {
+                    id: i.0 as u64,
+                    why: "was removed".into(),
+                })
+            }
+            Some(&p) => p,
+        };
+        self.input_point[i.index()] = PointId::NONE;
+        if p == HIDDEN {
+            self.hidden.remove(&i);
+            return Ok(());
+        }
+        if self.duplicates > 0 {
+            let others = self.inputs_of(p);
+            if let Some(&next) = others.first() {
+                self.duplicates -= 1;
+                self.point_input[p.index()] = next;
+                return Ok(());
+            }
+        }
+        self.engine.remove_point(p);
+        self.forget_point(p);
+        let hidden: Vec<(InputId, [f64; 3])> = self.hidden.iter().map(|(&j, &x)| (j, x)).collect();
+        for (j, x) in hidden {
+            if self.engine.would_appear(x, 0.0) {
+                self.hidden.remove(&j);
+                self.insert_checked(j, x);
+            }
+        }
+        Ok(())
+    }
+
+    /// Number of input points given (removed ones included: ids are never reused).
+    pub fn number_of_input_points(&self) -> usize {
+        self.input_point.len()
+    }
+
+    /// Number of vertices: distinct points that are not hidden.
+    pub fn number_of_vertices(&self) -> usize {
+        self.engine.number_of_points()
+    }
+
+    /// Inputs that coincide with an earlier one.
+    pub fn duplicates(&self) -> usize {
+        self.duplicates
+    }
+
+    /// The hidden inputs, sorted.
+    pub fn hidden(&self) -> Vec<InputId> {
+        self.hidden.keys().copied().collect()
+    }
+
+    /// What became of input `i`, `None` for an id never given or removed.
+    pub fn status(&self, i: InputId) -> Option<Status> {
+        match *self.input_point.get(i.index())? {
+            PointId::NONE => None,
+            HIDDEN => Some(Status::Hidden),
+            p if self.point_input[p.index()] == i => Some(Status::Vertex),
+            p => Some(Status::Duplicate(self.point_input[p.index()])),
+        }
+    }
+
+    /// The coordinates of input `i` as stored (its first occurrence's for a duplicate).
+    pub fn point(&self, i: InputId) -> Option<[f64; 3]> {
+        match *self.input_point.get(i.index())? {
+            PointId::NONE => None,
+            HIDDEN => self.hidden.get(&i).copied(),
+            p => Some(self.engine.points()[p.index()]),
+        }
+    }
+
+    /// The input ids of the vertices, in the engine's order.
+    pub fn vertices(&self) -> Vec<InputId> {
+        self.point_input[self.anchors()..].to_vec()
+    }
+
+    fn anchors(&self) -> usize {
+        self.engine.points().len() - self.engine.number_of_points()
+    }
+
+    /// The dimension of the triangulation as CGAL's `Triangulation_on_sphere_2` gives it:
+    /// −2 without vertices, −1 with one, 0 with two, 1 when all vertices lie on one plane
+    /// (one circle of the sphere), 2 otherwise.
+    pub fn dimension(&self) -> i32 {
+        let pts = &self.engine.points()[self.anchors()..];
+        match pts.len() {
+            0 => -2,
+            1 => -1,
+            2 => 0,
+            _ => {
+                // three distinct points near the sphere are never on one line
+                let (a, b) = (&pts[0], &pts[1]);
+                let Some(c) = pts[2..].iter().find(|c| !collinear(a, b, c)) else {
+                    return 1;
+                };
+                if pts.iter().any(|q| side_of_circle(a, b, c, q) != Sign::Zero) {
+                    2
+                } else {
+                    1
+                }
+            }
+        }
+    }
+
+    /// True when the points enclose the centre strictly (no anchor is a vertex): the
+    /// faces then cover the sphere. Otherwise the points lie in a closed hemisphere, and
+    /// the faces cover the part of the sphere where the hull has the centre inside.
+    pub fn covers_sphere(&self) -> bool {
+        (0..self.anchors()).all(|a| self.engine.is_hidden_anchor(PointId::new(a)))
+    }
+
+    /// True for an engine cell with no anchor.
+    fn is_face(&self, c: CellId) -> bool {
+        let anchors = self.anchors() as u32;
+        self.engine.cell(c).v.iter().all(|v| v.0 >= anchors)
+    }
+
+    /// The faces (CGAL's solid faces) by input ids of their vertices, counter-clockwise
+    /// seen from outside; none when [`Self::dimension`] is below 2.
+    pub fn faces(&self) -> Vec<[InputId; 3]> {
+        if self.dimension() < 2 {
+            return Vec::new();
+        }
+        self.face_ids()
+            .map(|c| self.engine.cell(c).v.map(|v| self.point_input[v.index()]))
+            .collect()
+    }
+
+    /// The engine cells that are faces.
+    fn face_ids(&self) -> impl Iterator<Item = CellId> + '_ {
+        self.engine.cell_ids().filter(|&c| self.is_face(c))
+    }
+
+    /// For each face of [`Self::faces`], the face across each edge (edge `k` is opposite
+    /// vertex `k`), `None` beyond the faces (where the hull turns its outer side to the
+    /// centre: the points lie in a hemisphere).
+    pub fn neighbors(&self) -> Vec<[Option<usize>; 3]> {
+        if self.dimension() < 2 {
+            return Vec::new();
+        }
+        let mut index = vec![usize::MAX; self.engine.cell_slots()];
+        for (k, c) in self.face_ids().enumerate() {
+            index[c.index()] = k;
+        }
+        self.face_ids()
+            .map(|c| {
+                self.engine
+                    .cell(c)
+                    .n
+                    .map(|d| Some(index[d.index()]).filter(|&k| k != usize::MAX))
+            })
+            .collect()
+    }
+
+    /// The Delaunay neighbours of input `i` (vertices joined to it by an edge of a face),
+    /// sorted; empty for a hidden input.
+    pub fn vertex_neighbors(&self, i: InputId) -> Result<Vec<InputId>> {
+        let p = self.live(i)?;
+        if p == HIDDEN {
+            return Ok(Vec::new());
+        }
+        let mut out: Vec<InputId> = self
+            .engine
+            .neighbours(VertexId(p.0))
+            .into_iter()
+            .map(|(v, _)| self.point_input[v.index()])
+            .filter(|&j| j != InputId::NONE)
+            .collect();
+        out.sort_unstable();
+        Ok(out)
+    }
+
+    /// The engine point of a live input, or the error naming it.
+    fn live(&self, i: InputId) -> Result<PointId> {
+        match self.input_point.get(i.index()) {
+            Some(&p) if p != PointId::NONE => Ok(p),
+            _ => Err(Error::UnknownInput {
+                id: i.0 as u64,
+                why: "was never given or was removed".into(),
+            }),
+        }
+    }
+
+    /// The face whose cone from the centre holds the direction `p` (any non-zero finite
+    /// vector), `None` outside the faces (a hemisphere set).
+    pub fn locate(&self, p: [f64; 3]) -> Result<Option<[InputId; 3]>> {
+        check_finite(0, &p)?;
+        if p == [0.0; 3] {
+            return Err(Error::OffSphere {
+                index: 0,
+                norm: 0.0,
+            });
+        }
+        let (c, _) = self.engine.locate(p);
+        Ok(self
+            .is_face(c)
+            .then(|| self.engine.cell(c).v.map(|v| self.point_input[v.index()])))
+    }
+
+    /// Checks the engine's triangulation (orientation, local Delaunay, Euler
+    /// characteristic 2) and that every face holds the centre strictly inside.
+    pub fn is_valid(&self) -> std::result::Result<(), Invalid> {
+        self.engine.is_valid()?;
+        for c in self.face_ids() {
+            let cell = self.engine.cell(c);
+            let [a, b, d] = cell.v.map(|v| self.engine.points()[v.index()]);
+            if orient_origin(&a, &b, &d) != Sign::Positive {
+                return Err(Invalid(format!(
+                    "face {c} does not face away from the centre"
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// The engine (for the Voronoi layer and tests).
+    pub fn engine(&self) -> &Engine<Sphere, 3> {
+        &self.engine
+    }
+}
+
+/// True when three points lie on one line (exactly): then no plane passes through them,
+/// and every point, among them four affinely independent ones, is on "their plane".
+fn collinear(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> bool {
+    [[0.0; 3], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0], [0.0, 0.0, 4.0]]
+        .iter()
+        .all(|q| side_of_circle(a, b, c, q) == Sign::Zero)
+}

@@ -1,0 +1,192 @@
+//! Spherical Voronoi cells, dual to the faces: a cell is the spherical polygon whose
+//! vertices are the poles of the faces around its site (their circumcentres on the sphere)
+//! and whose edges are great-circle arcs. Faces whose four points lie on one circle share
+//! one pole, found exactly (the unperturbed in-circle test), so the cells tile the sphere
+//! with no zero-length arc; areas sum to 4π to within rounding.
+
+use rayon::prelude::*;
+
+use super::SphericalDelaunay;
+use crate::error::{Error, Result};
+use crate::ids::{CellId, InputId, VertexId};
+use crate::space::{pole, OrbitSpace, Sphere};
+
+/// The Voronoi cell of one vertex on the sphere.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SphericalCell {
+    /// The input id of the site (the first occurrence of its point).
+    pub site: InputId,
+    /// The polygon's vertices on the unit sphere, counter-clockwise seen from outside.
+    pub vertices: Vec<[f64; 3]>,
+    /// `neighbors[k]`: the site across the arc from `vertices[k]` to `vertices[k + 1]`.
+    pub neighbors: Vec<InputId>,
+    /// The length (angle in radians) of each arc, in the same order.
+    pub arc_lengths: Vec<f64>,
+    /// The area (solid angle in steradians); the cells' areas sum to 4π.
+    pub area: f64,
+    /// The centroid: the unit vector along the integral of the position over the cell.
+    pub centroid: [f64; 3],
+}
+
+fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn cross(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn unit(a: [f64; 3]) -> [f64; 3] {
+    let n = dot(&a, &a).sqrt();
+    a.map(|x| x / n)
+}
+
+/// The signed area of the spherical triangle of unit vectors `s, a, b` (Van Oosterom and
+/// Strackee), positive when counter-clockwise seen from outside.
+fn triangle_area(s: &[f64; 3], a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    // det[s; a; b] through differences: no cancellation for a small triangle
+    let u = [a[0] - s[0], a[1] - s[1], a[2] - s[2]];
+    let v = [b[0] - s[0], b[1] - s[1], b[2] - s[2]];
+    let det = dot(s, &cross(&u, &v));
+    2.0 * det.atan2(1.0 + dot(s, a) + dot(a, b) + dot(b, s))
+}
+
+/// The root of `x` in a union-find forest, halving paths on the way.
+fn root(parent: &mut [u32], mut x: u32) -> u32 {
+    while parent[x as usize] != x {
+        let up = parent[parent[x as usize] as usize];
+        parent[x as usize] = up;
+        x = up;
+    }
+    x
+}
+
+impl SphericalDelaunay {
+    /// The Voronoi cell of every vertex, in the order of [`Self::vertices`]. Points in a
+    /// closed hemisphere (see [`Self::covers_sphere`]), or of dimension below 2, are
+    /// [`Error::Hemisphere`].
+    ///
+    /// ```
+    /// use orbitri::spherical::SphericalDelaunay;
+    /// let cube: Vec<[f64; 3]> = (0..8)
+    ///     .map(|k| [0, 1, 2].map(|b| if k >> b & 1 == 1 { 1.0 } else { -1.0 } / 3f64.sqrt()))
+    ///     .collect();
+    /// let tri = SphericalDelaunay::build(&cube).unwrap();
+    /// let cells = tri.voronoi_cells().unwrap();
+    /// // the cube's square faces are cocircular: each cell is a spherical triangle
+    /// assert!(cells.iter().all(|c| c.vertices.len() == 3));
+    /// let total: f64 = cells.iter().map(|c| c.area).sum();
+    /// assert!((total - 4.0 * std::f64::consts::PI).abs() < 1e-12);
+    /// ```
+    pub fn voronoi_cells(&self) -> Result<Vec<SphericalCell>> {
+        let dimension = self.dimension();
+        if dimension < 2 || !self.covers_sphere() {
+            return Err(Error::Hemisphere {
+                points: self.number_of_vertices(),
+                dimension,
+            });
+        }
+        let e = self.engine();
+        let ids: Vec<CellId> = e.cell_ids().collect();
+        // faces on one circle: one class, one pole
+        let mut parent: Vec<u32> = (0..e.cell_slots() as u32).collect();
+        let merges: Vec<(u32, u32)> = ids
+            .par_iter()
+            .flat_map_iter(|&c| {
+                let cell = e.cell(c);
+                let s = e.lifted_cell(c);
+                (0..3).filter_map(move |k| {
+                    let d = cell.n[k];
+                    if d < c {
+                        return None;
+                    }
+                    let dc = e.cell(d);
+                    let j = dc.mirror(c).expect("symmetric neighbours");
+                    Sphere.cospherical(&s, e.lifted(d, j)).then_some((c.0, d.0))
+                })
+            })
+            .collect();
+        for (a, b) in merges {
+            let (ra, rb) = (root(&mut parent, a), root(&mut parent, b));
+            parent[ra.max(rb) as usize] = ra.min(rb);
+        }
+        for c in 0..parent.len() as u32 {
+            root(&mut parent, c);
+        }
+        let mut poles = vec![[0.0; 3]; e.cell_slots()];
+        let computed: Vec<(CellId, [f64; 3])> = ids
+            .par_iter()
+            .filter(|c| parent[c.index()] == c.0)
+            .map(|&c| {
+                let [a, b, d] = e.lifted_cell(c).map(|x| x.0);
+                (c, pole(&a, &b, &d))
+            })
+            .collect();
+        for (c, p) in computed {
+            poles[c.index()] = p;
+        }
+        let anchors = self.point_input.len() - self.number_of_vertices();
+        Ok((anchors..self.point_input.len())
+            .into_par_iter()
+            .map(|p| self.cell_of(VertexId::new(p), &parent, &poles))
+            .collect())
+    }
+
+    /// The cell of vertex `v`: the classes of the faces around it, counter-clockwise.
+    fn cell_of(&self, v: VertexId, class: &[u32], poles: &[[f64; 3]]) -> SphericalCell {
+        let e = self.engine();
+        let mut ring: Vec<(u32, InputId)> = Vec::new();
+        let start = e.vcell[v.index()];
+        let mut c = start;
+        loop {
+            let cell = e.cell(c);
+            let i = cell.index_of(v).expect("the star holds its vertex");
+            // the next face counter-clockwise shares the edge to the vertex after next
+            let x = cell.v[(i + 2) % 3];
+            let k = class[c.index()];
+            if ring.last().map(|r| r.0) == Some(k) {
+                ring.last_mut().expect("non-empty").1 = self.point_input[x.index()];
+            } else {
+                ring.push((k, self.point_input[x.index()]));
+            }
+            c = cell.n[(i + 1) % 3];
+            if c == start {
+                break;
+            }
+        }
+        // (the arc from the last class back to the first is degenerate when they are one)
+        if ring.len() > 1 && ring[0].0 == ring[ring.len() - 1].0 {
+            ring.pop();
+        }
+        let site = unit(e.points()[v.index()]);
+        let vertices: Vec<[f64; 3]> = ring.iter().map(|r| poles[r.0 as usize]).collect();
+        let m = vertices.len();
+        let (mut area, mut moment) = (0.0, [0.0; 3]);
+        let mut arc_lengths = Vec::with_capacity(m);
+        for k in 0..m {
+            let (a, b) = (&vertices[k], &vertices[(k + 1) % m]);
+            area += triangle_area(&site, a, b);
+            let n = cross(a, b);
+            let len = dot(&n, &n).sqrt();
+            let theta = len.atan2(dot(a, b));
+            arc_lengths.push(theta);
+            if len > 0.0 {
+                for (mk, nk) in moment.iter_mut().zip(n) {
+                    *mk += theta * nk / len;
+                }
+            }
+        }
+        SphericalCell {
+            site: self.point_input[v.index()],
+            neighbors: ring.iter().map(|r| r.1).collect(),
+            vertices,
+            arc_lengths,
+            area,
+            centroid: unit(moment),
+        }
+    }
+}

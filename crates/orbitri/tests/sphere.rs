@@ -1,0 +1,364 @@
+//! The sphere: faces against an independent brute-force hull, order independence, exact
+//! degenerate sets (cube, octahedron, lon/lat grids with repeated poles), small sets and
+//! hemispheres (CGAL's dimension), hidden points, removals against fresh builds, and the
+//! Voronoi cells (areas, the equal-distance property of their vertices).
+
+use std::collections::BTreeSet;
+use std::f64::consts::PI;
+
+use orbitri::predicates::spherical::{orient_origin, side_of_circle};
+use orbitri::predicates::Sign;
+use orbitri::sort::SplitMix;
+use orbitri::spherical::{lonlat_to_point, normalized, SphericalDelaunay, Status};
+use orbitri::{Error, InputId};
+
+fn random_unit(r: &mut SplitMix) -> [f64; 3] {
+    loop {
+        let v = [
+            r.unit() * 2.0 - 1.0,
+            r.unit() * 2.0 - 1.0,
+            r.unit() * 2.0 - 1.0,
+        ];
+        let n = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+        if n > 0.01 && n <= 1.0 {
+            return v.map(|x| x / n.sqrt());
+        }
+    }
+}
+
+fn random_points(n: usize, seed: u64) -> Vec<[f64; 3]> {
+    let mut r = SplitMix::new(seed);
+    (0..n).map(|_| random_unit(&mut r)).collect()
+}
+
+/// A face as a rotation-invariant key: its least id first, the cyclic order kept.
+fn key(f: [InputId; 3]) -> [u32; 3] {
+    let k = (0..3).min_by_key(|&k| f[k]).unwrap();
+    [f[k].0, f[(k + 1) % 3].0, f[(k + 2) % 3].0]
+}
+
+fn face_set(tri: &SphericalDelaunay) -> BTreeSet<[u32; 3]> {
+    tri.faces().into_iter().map(key).collect()
+}
+
+/// No point strictly beyond the plane of any face (unperturbed, exact), every face
+/// counter-clockwise about the centre, and the face count of a triangulated sphere.
+fn check_empty(tri: &SphericalDelaunay, pts: &[[f64; 3]]) {
+    tri.is_valid().unwrap();
+    for f in tri.faces() {
+        let [a, b, c] = f.map(|i| pts[i.index()]);
+        assert_eq!(orient_origin(&a, &b, &c), Sign::Positive);
+        for q in pts {
+            assert_ne!(side_of_circle(&a, &b, &c, q), Sign::Positive, "{f:?}");
+        }
+    }
+    if tri.covers_sphere() {
+        assert_eq!(tri.faces().len(), 2 * tri.number_of_vertices() - 4);
+    }
+}
+
+/// The faces of the hull by brute force over all triples (points in general position).
+fn brute_hull(pts: &[[f64; 3]]) -> BTreeSet<[u32; 3]> {
+    let n = pts.len();
+    let mut out = BTreeSet::new();
+    for i in 0..n {
+        for j in 0..n {
+            for k in 0..n {
+                if i == j || j == k || i == k {
+                    continue;
+                }
+                let (a, b, c) = (&pts[i], &pts[j], &pts[k]);
+                if orient_origin(a, b, c) != Sign::Positive {
+                    continue;
+                }
+                if pts
+                    .iter()
+                    .all(|q| side_of_circle(a, b, c, q) != Sign::Positive)
+                {
+                    out.insert(key([i, j, k].map(InputId::new)));
+                }
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn random_faces_equal_the_brute_force_hull() {
+    for seed in 0..5 {
+        let pts = random_points(40, seed);
+        let tri = SphericalDelaunay::build(&pts).unwrap();
+        assert_eq!(tri.dimension(), 2);
+        assert!(tri.covers_sphere());
+        assert_eq!(face_set(&tri), brute_hull(&pts), "seed {seed}");
+    }
+    let pts = random_points(3000, 7);
+    let tri = SphericalDelaunay::build(&pts).unwrap();
+    assert_eq!(tri.number_of_vertices(), 3000);
+    check_empty(&tri, &pts);
+}
+
+#[test]
+fn faces_do_not_depend_on_the_order() {
+    // a lon/lat grid: many cocircular quadruples, so the perturbation decides
+    let mut pts = Vec::new();
+    for i in 0..24 {
+        for j in -5..=5 {
+            pts.push(lonlat_to_point(0, i as f64 * 15.0, j as f64 * 15.0).unwrap());
+        }
+    }
+    let tri = SphericalDelaunay::build(&pts).unwrap();
+    check_empty(&tri, &pts);
+    let reference: BTreeSet<[[u64; 3]; 3]> = tri
+        .faces()
+        .into_iter()
+        .map(|f| coords_key(f.map(|i| pts[i.index()])))
+        .collect();
+    let mut r = SplitMix::new(5);
+    for _ in 0..3 {
+        let mut shuffled = pts.clone();
+        for k in (1..shuffled.len()).rev() {
+            shuffled.swap(k, r.below(k + 1));
+        }
+        // one by one in the shuffled order, not the built-in spatial order
+        let mut t = SphericalDelaunay::new();
+        for p in &shuffled {
+            t.insert(*p).unwrap();
+        }
+        let got: BTreeSet<[[u64; 3]; 3]> = t
+            .faces()
+            .into_iter()
+            .map(|f| coords_key(f.map(|i| shuffled[i.index()])))
+            .collect();
+        assert_eq!(got, reference);
+    }
+}
+
+/// A face by its coordinates, rotated to start at the least.
+fn coords_key(f: [[f64; 3]; 3]) -> [[u64; 3]; 3] {
+    let b = f.map(|p| p.map(f64::to_bits));
+    let k = (0..3).min_by_key(|&k| b[k]).unwrap();
+    [b[k], b[(k + 1) % 3], b[(k + 2) % 3]]
+}
+
+#[test]
+fn exact_degenerate_sets() {
+    let s = 3f64.sqrt().recip();
+    let cube: Vec<[f64; 3]> = (0..8)
+        .map(|k| [0, 1, 2].map(|b| if k >> b & 1 == 1 { s } else { -s }))
+        .collect();
+    let octahedron = vec![
+        [1.0, 0.0, 0.0],
+        [-1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, -1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [0.0, 0.0, -1.0],
+    ];
+    // a lon/lat grid whose poles are given once per longitude
+    let mut grid = Vec::new();
+    for i in 0..36 {
+        for j in -9..=9 {
+            grid.push(lonlat_to_point(0, i as f64 * 10.0, j as f64 * 10.0).unwrap());
+        }
+    }
+    for (name, pts, vertices) in [
+        ("cube", cube, 8),
+        ("octahedron", octahedron, 6),
+        ("grid", grid, 36 * 17 + 2),
+    ] {
+        let tri = SphericalDelaunay::build(&pts).unwrap();
+        check_empty(&tri, &pts);
+        assert!(tri.hidden().is_empty(), "{name}");
+        assert_eq!(tri.number_of_vertices(), vertices, "{name}");
+        assert_eq!(tri.duplicates(), pts.len() - vertices, "{name}");
+        let cells = tri.voronoi_cells().unwrap();
+        let total: f64 = cells.iter().map(|c| c.area).sum();
+        assert!((total - 4.0 * PI).abs() < 1e-12, "{name}: {total}");
+    }
+}
+
+#[test]
+fn small_sets_and_hemispheres_follow_cgal() {
+    let e = [
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [0.6, 0.8, 0.0],
+    ];
+    let mut tri = SphericalDelaunay::new();
+    assert_eq!(tri.dimension(), -2);
+    tri.insert(e[0]).unwrap();
+    assert_eq!(tri.dimension(), -1);
+    tri.insert(e[1]).unwrap();
+    assert_eq!(tri.dimension(), 0);
+    tri.insert(e[3]).unwrap();
+    // three points on the equator: one plane
+    assert_eq!(tri.dimension(), 1);
+    assert!(tri.faces().is_empty());
+    tri.is_valid().unwrap();
+    tri.insert(e[2]).unwrap();
+    assert_eq!(tri.dimension(), 2);
+    // four points in a hemisphere: the faces that face away from the centre only
+    assert!(!tri.covers_sphere());
+    check_empty(&tri, &[e[0], e[1], e[3], e[2]]);
+    assert!(matches!(
+        tri.voronoi_cells(),
+        Err(Error::Hemisphere { points: 4, .. })
+    ));
+    // the south pole alone does not enclose the centre (every point has x ≥ 0) ...
+    tri.insert([0.0, 0.0, -1.0]).unwrap();
+    assert!(!tri.covers_sphere());
+    tri.is_valid().unwrap();
+    tri.remove(InputId(4)).unwrap();
+    // ... a point below all three axes does
+    tri.insert([-0.5, -0.5, -0.5f64.sqrt()]).unwrap();
+    assert!(tri.covers_sphere());
+    tri.is_valid().unwrap();
+    assert_eq!(tri.faces().len(), 6);
+
+    // a random hemisphere: faces equal the brute-force hull's faces about the centre
+    let pts: Vec<[f64; 3]> = random_points(60, 3)
+        .into_iter()
+        .map(|p| [p[0], p[1], p[2].abs()])
+        .collect();
+    let tri = SphericalDelaunay::build(&pts).unwrap();
+    assert!(!tri.covers_sphere());
+    check_empty(&tri, &pts);
+    assert_eq!(face_set(&tri), brute_hull(&pts));
+    // and every point is a vertex
+    assert_eq!(tri.number_of_vertices(), 60);
+}
+
+#[test]
+fn points_inside_the_hull_are_hidden_and_come_back() {
+    let mut pts = random_points(200, 11);
+    // four points within 1e-4 of the north pole around a fifth pulled in by 4e-7
+    let d = 1e-4;
+    let cap = [[d, 0.0], [0.0, d], [-d, 0.0], [0.0, -d]];
+    for [x, y] in cap {
+        pts.push(normalized(&[[x, y, 1.0]]).unwrap()[0]);
+    }
+    pts.push([0.0, 0.0, 1.0 - 4e-7]);
+    let inner = InputId::new(pts.len() - 1);
+    let mut tri = SphericalDelaunay::build(&pts).unwrap();
+    assert_eq!(tri.hidden(), vec![inner]);
+    assert_eq!(tri.status(inner), Some(Status::Hidden));
+    assert_eq!(tri.number_of_vertices(), 204);
+    check_empty(&tri, &pts);
+    // the cap's plane is 5e-9 below the pole: without one of its points the others, and
+    // then the faces to the random points around, still cover the inner point ...
+    tri.remove(InputId(200)).unwrap();
+    assert_eq!(tri.status(inner), Some(Status::Hidden));
+    for k in 201..204 {
+        tri.remove(InputId(k)).unwrap();
+    }
+    // ... until the cap is gone: the nearest faces are then far below it
+    assert_eq!(tri.status(inner), Some(Status::Vertex));
+    assert!(tri.hidden().is_empty());
+    tri.is_valid().unwrap();
+    // inserting the cap again hides it again
+    for p in &pts[200..204] {
+        assert_eq!(tri.insert(*p).unwrap(), Status::Vertex);
+    }
+    assert_eq!(tri.status(inner), Some(Status::Hidden));
+    assert_eq!(tri.number_of_vertices(), 204);
+    tri.is_valid().unwrap();
+}
+
+#[test]
+fn removals_equal_fresh_builds() {
+    let pts = random_points(400, 21);
+    let mut tri = SphericalDelaunay::build(&pts).unwrap();
+    let mut r = SplitMix::new(2);
+    let mut alive: Vec<usize> = (0..pts.len()).collect();
+    for step in 0..396 {
+        let k = alive.swap_remove(r.below(alive.len()));
+        tri.remove(InputId::new(k)).unwrap();
+        assert!(tri.remove(InputId::new(k)).is_err());
+        if step % 37 == 0 || alive.len() < 12 {
+            tri.is_valid().unwrap();
+            let kept: Vec<[f64; 3]> = alive.iter().map(|&i| pts[i]).collect();
+            let fresh = SphericalDelaunay::build(&kept).unwrap();
+            let ours: BTreeSet<[[u64; 3]; 3]> = tri
+                .faces()
+                .into_iter()
+                .map(|f| coords_key(f.map(|i| pts[i.index()])))
+                .collect();
+            let theirs: BTreeSet<[[u64; 3]; 3]> = fresh
+                .faces()
+                .into_iter()
+                .map(|f| coords_key(f.map(|i| kept[i.index()])))
+                .collect();
+            assert_eq!(ours, theirs, "after {} removals", step + 1);
+            assert_eq!(tri.dimension(), fresh.dimension());
+            assert_eq!(tri.covers_sphere(), fresh.covers_sphere());
+        }
+    }
+    assert_eq!(tri.number_of_vertices(), 4);
+}
+
+#[test]
+fn bad_input_is_a_typed_error() {
+    assert!(matches!(
+        SphericalDelaunay::build(&[]),
+        Err(Error::EmptyInput)
+    ));
+    let r = SphericalDelaunay::build(&[[1.0, 0.0, 0.0], [0.0, 2.0, 0.0]]);
+    assert!(matches!(r, Err(Error::OffSphere { index: 1, .. })), "{r:?}");
+    let r = SphericalDelaunay::build(&[[f64::NAN, 0.0, 1.0]]);
+    assert!(matches!(
+        r,
+        Err(Error::NonFiniteCoordinate { index: 0, .. })
+    ));
+    assert!(SphericalDelaunay::build_lonlat(&[[0.0, 91.0]]).is_err());
+    assert!(normalized(&[[0.0; 3]]).is_err());
+    let mut tri = SphericalDelaunay::build(&random_points(10, 1)).unwrap();
+    assert!(tri.insert([0.0, 0.0, 0.5]).is_err());
+    assert_eq!(tri.number_of_input_points(), 10);
+    assert!(tri.remove(InputId(10)).is_err());
+    tri.is_valid().unwrap();
+}
+
+#[test]
+fn lonlat_is_exact_at_the_poles_and_axes() {
+    assert_eq!(lonlat_to_point(0, 0.0, 90.0).unwrap(), [0.0, 0.0, 1.0]);
+    assert_eq!(lonlat_to_point(0, 123.0, -90.0).unwrap()[2], -1.0);
+    assert_eq!(lonlat_to_point(0, 90.0, 0.0).unwrap(), [0.0, 1.0, 0.0]);
+    assert_eq!(lonlat_to_point(0, -180.0, 0.0).unwrap(), [-1.0, 0.0, 0.0]);
+    let p = lonlat_to_point(0, 30.0, 45.0).unwrap();
+    let back = orbitri::spherical::point_to_lonlat(&p);
+    assert!((back[0] - 30.0).abs() < 1e-12 && (back[1] - 45.0).abs() < 1e-12);
+}
+
+#[test]
+fn voronoi_vertices_are_equidistant_and_areas_sum_to_four_pi() {
+    let pts = random_points(20_000, 5);
+    let tri = SphericalDelaunay::build(&pts).unwrap();
+    let cells = tri.voronoi_cells().unwrap();
+    assert_eq!(cells.len(), 20_000);
+    let total: f64 = cells.iter().map(|c| c.area).sum();
+    assert!((total - 4.0 * PI).abs() < 1e-12 * 4.0 * PI, "{total}");
+    let dot = |a: &[f64; 3], b: &[f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    for c in cells.iter().step_by(97) {
+        let s = pts[c.site.index()];
+        assert!(c.area > 0.0);
+        assert!(dot(&c.centroid, &s) > 0.99);
+        for (k, v) in c.vertices.iter().enumerate() {
+            // the arc's two sites are equally far from both its ends
+            let n = pts[c.neighbors[k].index()];
+            let w = &c.vertices[(k + 1) % c.vertices.len()];
+            assert!((dot(v, &s) - dot(v, &n)).abs() < 1e-12);
+            assert!((dot(w, &s) - dot(w, &n)).abs() < 1e-12);
+            assert!(c.arc_lengths[k] > 0.0);
+        }
+    }
+    // neighbours are mutual
+    let by_site: std::collections::HashMap<InputId, &orbitri::SphericalCell> =
+        cells.iter().map(|c| (c.site, c)).collect();
+    for c in cells.iter().step_by(13) {
+        for n in &c.neighbors {
+            assert!(by_site[n].neighbors.contains(&c.site));
+        }
+    }
+}
