@@ -1,6 +1,7 @@
 //! The `orbitri` command.
 
 mod rss;
+mod sphere;
 
 use std::ffi::OsString;
 use std::io::{BufWriter, IsTerminal, Write};
@@ -145,31 +146,50 @@ enum Command {
 /// The names `--space` takes besides the closed flat 3-manifolds'
 /// (`FlatManifold::PLATYCOSMS`).
 const TORUS_AND_KLEIN: [&str; 2] = ["torus", "klein"];
+/// The spaces without a box.
+const SPHERES: [&str; 1] = ["sphere"];
 
 #[derive(Args)]
 struct Domain {
     /// The orbit space: a flat torus (default), the Klein bottle (2D: --box L1 L2, the glide
-    /// along the first axis) or a closed flat 3-manifold (--box L1 L2 L3, the sides of its
-    /// standard domain)
-    #[arg(long, value_name = "NAME", default_value = "torus", value_parser = PossibleValuesParser::new(TORUS_AND_KLEIN.into_iter().chain(FlatManifold::PLATYCOSMS)))]
+    /// along the first axis), a closed flat 3-manifold (--box L1 L2 L3, the sides of its
+    /// standard domain), or the unit sphere (no box: points are unit vectors `x y z`, or
+    /// with --lonlat longitude and latitude in degrees)
+    #[arg(long, value_name = "NAME", default_value = "torus", value_parser = PossibleValuesParser::new(TORUS_AND_KLEIN.into_iter().chain(FlatManifold::PLATYCOSMS).chain(SPHERES)))]
     space: String,
     #[command(flatten)]
     extent: Extent,
+    #[command(flatten)]
+    on_sphere: OnSphere,
+}
+
+/// How points on the sphere are given.
+#[derive(Args)]
+struct OnSphere {
+    /// Sphere: each row is `longitude latitude` in degrees
+    #[arg(long)]
+    lonlat: bool,
+    /// Sphere: move each `x y z` radially onto the unit sphere first (otherwise each must
+    /// be a unit vector to within 1e-6)
+    #[arg(long, conflicts_with = "lonlat")]
+    normalize: bool,
 }
 
 /// The domain of `draw`: 2D only.
 #[derive(Args)]
 struct Domain2 {
-    /// The orbit space: a flat torus (default) or the Klein bottle (--box L1 L2, the glide
-    /// along the first axis)
-    #[arg(long, value_name = "NAME", default_value = "torus", value_parser = PossibleValuesParser::new(TORUS_AND_KLEIN))]
+    /// The orbit space: a flat torus (default), the Klein bottle (--box L1 L2, the glide
+    /// along the first axis), or the sphere (no box; drawn in an equal-area projection)
+    #[arg(long, value_name = "NAME", default_value = "torus", value_parser = PossibleValuesParser::new(TORUS_AND_KLEIN.into_iter().chain(SPHERES)))]
     space: String,
     #[command(flatten)]
     extent: Extent2,
+    #[command(flatten)]
+    on_sphere: OnSphere,
 }
 
 #[derive(Args)]
-#[group(required = true, multiple = false)]
+#[group(multiple = false)]
 struct Extent {
     /// Box lengths, 3 or 2: the domain is [0,LX) × [0,LY) × [0,LZ), or [0,LX) × [0,LY)
     #[arg(long = "box", num_args = 2..=6, value_names = ["LX", "LY", "LZ"], value_parser = number, allow_negative_numbers = true)]
@@ -187,7 +207,7 @@ struct Extent {
 
 /// The extent of a 2D domain (`draw`).
 #[derive(Args)]
-#[group(required = true, multiple = false)]
+#[group(multiple = false)]
 struct Extent2 {
     /// Box lengths: the domain is [0,LX) × [0,LY)
     #[arg(long = "box", num_args = 2, value_names = ["LX", "LY"], value_parser = number, allow_negative_numbers = true)]
@@ -214,6 +234,7 @@ impl From<Domain2> for Domain {
                 lattice,
                 cellpar,
             },
+            on_sphere: d.on_sphere,
         }
     }
 }
@@ -337,6 +358,18 @@ macro_rules! with_space {
 }
 
 fn space(domain: &Domain) -> Result<Space, CliError> {
+    let e = &domain.extent;
+    if e.box_lengths.is_none() && e.lattice.is_none() && e.cellpar.is_none() {
+        return Err(CliError::Usage(format!(
+            "--space {} needs its domain: --box, --lattice or --cellpar",
+            domain.space
+        )));
+    }
+    if domain.on_sphere.lonlat || domain.on_sphere.normalize {
+        return Err(CliError::Usage(
+            "--lonlat and --normalize are for --space sphere".into(),
+        ));
+    }
     match domain.space.as_str() {
         "torus" => torus(&domain.extent),
         name => manifold(name, &domain.extent),
@@ -376,7 +409,7 @@ fn torus(extent: &Extent) -> Result<Space, CliError> {
     let l = extent
         .lattice
         .as_ref()
-        .expect("clap requires --box or --lattice");
+        .expect("space() requires --box, --lattice or --cellpar");
     match l.len() {
         4 => Ok(Space::Torus2(FlatTorus2::triclinic([
             [l[0], l[1]],
@@ -509,6 +542,9 @@ fn triangulate(
     weighting: Weighting,
     out: Output,
 ) -> Result<(), CliError> {
+    if SPHERES.contains(&domain.space.as_str()) {
+        return sphere::triangulate(&input, &domain, &weighting, out);
+    }
     with_space!(space(&domain)?, triangulate_in(&input, &weighting, out))
 }
 
@@ -586,6 +622,9 @@ struct VoronoiArgs {
 }
 
 fn voronoi(input: PathBuf, domain: Domain, args: VoronoiArgs) -> Result<(), CliError> {
+    if SPHERES.contains(&domain.space.as_str()) {
+        return sphere::voronoi(&input, &domain, args);
+    }
     with_space!(space(&domain)?, voronoi_in(&input, args))
 }
 
@@ -679,6 +718,9 @@ fn draw(
             ext.map_or("a name without extension".to_string(), |e| format!(".{e}"))
         )));
     }
+    if SPHERES.contains(&domain.space.as_str()) {
+        return sphere::draw(&input, &domain, &weighting, output, opts);
+    }
     match space(&domain)? {
         Space::Torus2(s) => draw_in(s, &input, &weighting, output, opts),
         Space::Klein(s) => draw_in(s, &input, &weighting, output, opts),
@@ -715,6 +757,11 @@ fn draw_in<S: Drawable>(
             },
         }
     })?;
+    write_picture(output, svg)
+}
+
+/// Writes an SVG picture to `output`, rendered to PNG for a `.png` name.
+fn write_picture(output: PathBuf, svg: Vec<u8>) -> Result<(), CliError> {
     let png = output
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("png"));

@@ -33,9 +33,50 @@ impl SplitMix {
     }
 }
 
+/// The 2D Hilbert curve as a state machine, one level per step: entry `4·state + 2·bx + by`
+/// holds the level's two digits (low bits) and the next state (4 states). It gives the same
+/// index as Skilling's algorithm, in a quarter of the time.
+const HILBERT2: [u8; 16] = [4, 1, 11, 2, 0, 15, 5, 6, 10, 9, 3, 12, 14, 7, 13, 8];
+
+/// [`HILBERT2`] two levels at a time: entry `16·state + 4·(x's two bits) + (y's two bits)`
+/// holds the four digits (low bits) and the next state.
+const HILBERT2X2: [u8; 64] = {
+    let mut t = [0u8; 64];
+    let mut i = 0;
+    while i < 64 {
+        let (state, x, y) = (i / 16, (i / 4) % 4, i % 4);
+        let hi = HILBERT2[4 * state + 2 * (x >> 1) + (y >> 1)];
+        let lo = HILBERT2[4 * (hi >> 2) as usize + 2 * (x & 1) + (y & 1)];
+        t[i] = ((hi & 3) << 2) | (lo & 3) | ((lo >> 2) << 4);
+        i += 1;
+    }
+    t
+};
+
+fn hilbert2(x: u32, y: u32, bits: u32) -> u64 {
+    let (mut h, mut state) = (0u64, 0usize);
+    let mut b = bits;
+    if b % 2 == 1 {
+        b -= 1;
+        let e = HILBERT2[2 * ((x >> b) & 1) as usize + ((y >> b) & 1) as usize];
+        h = u64::from(e & 3);
+        state = usize::from(e >> 2);
+    }
+    while b > 0 {
+        b -= 2;
+        let e = HILBERT2X2[16 * state + 4 * ((x >> b) & 3) as usize + ((y >> b) & 3) as usize];
+        h = (h << 4) | u64::from(e & 15);
+        state = usize::from(e >> 4);
+    }
+    h
+}
+
 /// Index of the grid cell `x` (each coordinate below `2^bits`, `D·bits ≤ 64`) along the
 /// `D`-dimensional Hilbert curve.
 pub fn hilbert<const D: usize>(mut x: [u32; D], bits: u32) -> u64 {
+    if D == 2 {
+        return hilbert2(x[0], x[1], bits);
+    }
     let top = 1u32 << (bits - 1);
     let mut q = top;
     while q > 1 {
@@ -91,17 +132,65 @@ pub fn brio_order(keys: &[u64], seed: u64) -> Vec<u32> {
         ends.push(m);
     }
     ends.reverse();
+    // each round sorted as (key, index) pairs: no lookup into `keys` per comparison, which
+    // missed the cache
+    let mut pairs: Vec<(u64, u32)> = idx.iter().map(|&i| (keys[i as usize], i)).collect();
     let mut start = 0;
     for end in ends {
-        idx[start..end].sort_unstable_by_key(|&i| keys[i as usize]);
+        pairs[start..end].sort_unstable();
         start = end;
     }
-    idx
+    pairs.into_iter().map(|(_, i)| i).collect()
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Skilling's transpose algorithm in 2D, as the general path computes it.
+    fn skilling2(x: [u32; 2], bits: u32) -> u64 {
+        let mut y = x;
+        let top = 1u32 << (bits - 1);
+        let mut q = top;
+        while q > 1 {
+            let p = q - 1;
+            for i in 0..2 {
+                if y[i] & q != 0 {
+                    y[0] ^= p;
+                } else {
+                    let t = (y[0] ^ y[i]) & p;
+                    y[0] ^= t;
+                    y[i] ^= t;
+                }
+            }
+            q >>= 1;
+        }
+        y[1] ^= y[0];
+        let (mut t, mut q) = (0, top);
+        while q > 1 {
+            if y[1] & q != 0 {
+                t ^= q - 1;
+            }
+            q >>= 1;
+        }
+        let mut h = 0u64;
+        for b in (0..bits).rev() {
+            for v in &y {
+                h = (h << 1) | u64::from(((v ^ t) >> b) & 1);
+            }
+        }
+        h
+    }
+
+    #[test]
+    fn the_2d_state_machine_is_skillings_curve() {
+        let mut r = SplitMix::new(4);
+        for _ in 0..20_000 {
+            let bits = 1 + r.below(16) as u32;
+            let x = [0, 1].map(|_| r.below(1 << bits) as u32);
+            assert_eq!(hilbert(x, bits), skilling2(x, bits), "{x:?} {bits}");
+        }
+    }
 
     #[test]
     fn splitmix_matches_the_anchor_test_vectors() {

@@ -186,10 +186,14 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 }
             }
         }
-        // weighted: a vertex of the region on none of its boundary facets is hidden; its
-        // vertex then points at no live cell once the new cells are attached
+        // a vertex of the region on none of its boundary facets is hidden; its vertex then
+        // points at no live cell once the new cells are attached. The region is a disk (a
+        // ball): in 2D, `C` triangles with `B` boundary edges have `1 + (C − B)/2` vertices
+        // inside, so `C = B − 2` means none, and the scan is skipped.
         let first_hidden = scratch.hidden.len();
-        if self.hides() {
+        let inner = N != 3 || scratch.conflict.len() + 2 != scratch.boundary.len();
+        let hiding = self.hides() && inner;
+        if hiding {
             for &(c, _) in &scratch.conflict {
                 scratch.hidden.extend(self.tds.cells[c.index()].v);
             }
@@ -200,7 +204,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         for &nc in &scratch.created {
             self.attach(nc);
         }
-        if self.hides() {
+        if hiding {
             let mut k = first_hidden;
             for j in first_hidden..scratch.hidden.len() {
                 let v = scratch.hidden[j];

@@ -5,6 +5,7 @@
 mod cellpar;
 mod format;
 mod npy;
+mod sphere;
 mod svg;
 mod tessellation;
 mod text;
@@ -15,6 +16,10 @@ pub use format::SpaceFormat;
 pub use npy::{
     encode_npy, encode_npy_array, encode_npy_matrix, encode_npz, parse_npy, read_npy, NpyArray,
     NpyData,
+};
+pub use sphere::{
+    sphere_point_table, write_sphere_cells, write_sphere_faces_vtu, write_sphere_json,
+    write_sphere_svg, write_spherical_voronoi_json, write_spherical_voronoi_vtu,
 };
 pub use svg::{write_svg, Drawable, SvgOptions, Tiling};
 pub use tessellation::{

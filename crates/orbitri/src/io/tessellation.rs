@@ -119,9 +119,9 @@ impl PointTable {
         };
         let mut arrays = vec![
             named("id", ints(0), None),
-            named("volume", floats(1), None),
+            named(&self.columns[1], floats(1), None),
             named("neighbours", ints(2), None),
-            named("surface_area", floats(3), None),
+            named(&self.columns[3], floats(3), None),
             named("centroid", NpyData::F64(centroid), Some(dim)),
         ];
         if let Some(k) = hidden {
@@ -226,20 +226,20 @@ pub fn write_voronoi_json<const D: usize, const N: usize, S: SpaceFormat<D, N>>(
 /// polyhedron face streams, and point and cell data arrays; written binary (see
 /// [`Vtu::write`]).
 #[derive(Default)]
-struct Vtu {
-    points: Vec<[f64; 3]>,
-    connectivity: Vec<i64>,
-    offsets: Vec<i64>,
-    types: Vec<u8>,
+pub(super) struct Vtu {
+    pub(super) points: Vec<[f64; 3]>,
+    pub(super) connectivity: Vec<i64>,
+    pub(super) offsets: Vec<i64>,
+    pub(super) types: Vec<u8>,
     /// For polyhedra: per cell `[n_faces, (n, ids…)…]`, and the running end offsets.
     faces: Vec<i64>,
     face_offsets: Vec<i64>,
-    point_data: Vec<(&'static str, Values)>,
-    cell_data: Vec<(&'static str, Values)>,
+    pub(super) point_data: Vec<(&'static str, Values)>,
+    pub(super) cell_data: Vec<(&'static str, Values)>,
 }
 
 /// The values of one VTK data array, and their number of components.
-enum Values {
+pub(super) enum Values {
     F64(Vec<f64>, usize),
     I64(Vec<i64>),
     U8(Vec<u8>),
@@ -303,7 +303,7 @@ fn vtk_zlib(bytes: &[u8], level: flate2::Compression) -> Vec<u8> {
 impl Vtu {
     /// The XML header, every array `format="appended"` at its offset, then the raw
     /// appended data (each array zlib-compressed: [`vtk_zlib`]).
-    fn write(&self, w: &mut impl Write) -> std::io::Result<()> {
+    pub(super) fn write(&self, w: &mut impl Write) -> std::io::Result<()> {
         let mut xml = String::new();
         let mut data: Vec<u8> = Vec::new();
         let mut array = |xml: &mut String, name: &str, values: &Values| {

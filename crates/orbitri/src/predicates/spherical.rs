@@ -40,11 +40,19 @@ fn direction(p: &[f64; 3]) -> [f64; 3] {
 
 /// `det[a; b; c]` exactly: the orientation of `a, b, c` about the origin (an anchor counts
 /// by its direction).
+#[inline]
 pub fn orient_origin(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> Sign {
     let rows = [*a, *b, *c];
-    if let Some(s) = filter::orient3(&rows, bounds(&rows)) {
-        return s;
+    match filter::orient3(&rows, bounds(&rows)) {
+        Some(s) => s,
+        None => orient_exact(rows),
     }
+}
+
+/// [`orient_origin`] in big integers.
+#[cold]
+#[inline(never)]
+fn orient_exact(rows: [[f64; 3]; 3]) -> Sign {
     let rows = rows.map(|r| direction(&r));
     let scale = Scaled::new(rows.iter().flatten().copied());
     let ints = rows.map(|r| r.map(|x| scale.int(x)));
@@ -55,15 +63,23 @@ pub fn orient_origin(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> Sign {
 /// `q` is inside their circumcircle on the sphere (away from the origin), `Zero` on it.
 /// Anchors are taken symbolically ([`anchored_side`]); when the filter decides, the
 /// infinitesimal terms are below its error bound and cannot change the sign.
+#[inline]
 pub fn side_of_circle(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3], q: &[f64; 3]) -> Sign {
     // det[b − a; c − a; q − a] is −det[a; b; c] at the origin: q and the origin are on
     // different sides exactly when it is positive
     let (d0, b0) = filter::plain_diff(b, a);
     let (d1, b1) = filter::plain_diff(c, a);
     let (d2, b2) = filter::plain_diff(q, a);
-    if let Some(s) = filter::orient3(&[d0, d1, d2], [b0, b1, b2]) {
-        return s;
+    match filter::orient3(&[d0, d1, d2], [b0, b1, b2]) {
+        Some(s) => s,
+        None => side_exact(a, b, c, q),
     }
+}
+
+/// [`side_of_circle`] in big integers.
+#[cold]
+#[inline(never)]
+fn side_exact(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3], q: &[f64; 3]) -> Sign {
     if [a, b, c, q].iter().any(|p| is_anchor(p)) {
         return anchored_side(&[*a, *b, *c, *q]);
     }
@@ -73,6 +89,52 @@ pub fn side_of_circle(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3], q: &[f64; 3]) ->
         std::array::from_fn(|k| scale.int(p[k]) - &ia[k])
     };
     exact::sign(&exact::det3(&diff(b), &diff(c), &diff(q)))
+}
+
+/// The largest coordinate of a point of the sphere (`|p|² ≤ 1 + 2⁻²⁰`) or of an anchor,
+/// in magnitude: the static filters below hold for such points.
+const UNIT_BOUND: f64 = 1.0 + 1.0 / (1u64 << 20) as f64;
+const U: f64 = f64::EPSILON * 0.5;
+
+fn det3(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> f64 {
+    a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+        + a[2] * (b[0] * c[1] - b[1] * c[0])
+}
+
+/// [`orient_origin`] of points with coordinates at most `1 + 2⁻²⁰` in magnitude (the
+/// sphere's): a static filter, no bounds to compute. With exact entries the evaluation
+/// errs by at most `7u` times the sum of the six products' magnitudes (Shewchuk), at most
+/// `42u·B³`; twice that decides. (Underflow with an anchor's tiny entries adds far less.)
+#[inline]
+pub fn orient_unit(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> Sign {
+    const ERR: f64 = 84.0 * U * UNIT_BOUND * UNIT_BOUND * UNIT_BOUND;
+    let det = det3(a, b, c);
+    if det > ERR {
+        Sign::Positive
+    } else if det < -ERR {
+        Sign::Negative
+    } else {
+        orient_origin(a, b, c)
+    }
+}
+
+/// [`side_of_circle`] of points with coordinates at most `1 + 2⁻²⁰` in magnitude: a static
+/// filter. The differences (at most `2B`) are each within `u` relative of the exact ones,
+/// which puts each of the six products of three within `3u` (plus second order), and the
+/// evaluation adds `7u` of their sum: at most `60u·(2B)³`; `1024u·B³` decides. When it
+/// decides with anchors among the points, their infinitesimal terms are far below it.
+#[inline]
+pub fn side_unit(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3], q: &[f64; 3]) -> Sign {
+    const ERR: f64 = 1024.0 * U * UNIT_BOUND * UNIT_BOUND * UNIT_BOUND;
+    let d = |p: &[f64; 3]| [p[0] - a[0], p[1] - a[1], p[2] - a[2]];
+    let det = det3(&d(b), &d(c), &d(q));
+    if det > ERR {
+        Sign::Positive
+    } else if det < -ERR {
+        Sign::Negative
+    } else {
+        side_of_circle(a, b, c, q)
+    }
 }
 
 /// [`side_of_circle`] with anchors among the points, exactly: the determinant
@@ -197,6 +259,36 @@ mod tests {
             .collect();
         let d = |i: usize| -> [Q; 3] { std::array::from_fn(|c| &pts[i][c] - &pts[0][c]) };
         sign(&det3(&[d(1), d(2), d(3)]))
+    }
+
+    #[test]
+    fn static_filters_agree_with_the_exact_signs() {
+        let mut r = crate::sort::SplitMix::new(12);
+        let mut unit = |spread: f64| {
+            let v = [r.unit() - 0.5, r.unit() - 0.5, r.unit() - 0.5].map(|x| x * spread);
+            let v = [v[0], v[1], 1.0 + v[2]];
+            let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+            v.map(|x| x / n)
+        };
+        // from spread-out points to points within 1e-7 of each other
+        for spread in [2.0, 1e-3, 1e-7] {
+            for _ in 0..3000 {
+                let (a, b, c, x) = (unit(spread), unit(spread), unit(spread), unit(spread));
+                assert_eq!(orient_unit(&a, &b, &c), orient_origin(&a, &b, &c));
+                let m = [a, b, c].map(|v| v.map(q));
+                assert_eq!(orient_unit(&a, &b, &c), sign(&det3(&m)));
+                let d = [b, c, x].map(|v| std::array::from_fn(|k| q(v[k]) - q(a[k])));
+                assert_eq!(side_unit(&a, &b, &c, &x), sign(&det3(&d)));
+            }
+        }
+        // an exact tie: four points on the equator
+        let e = [
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [-0.6, 0.8, 0.0],
+            [0.0, -1.0, 0.0],
+        ];
+        assert_eq!(side_unit(&e[0], &e[1], &e[2], &e[3]), Sign::Zero);
     }
 
     #[test]

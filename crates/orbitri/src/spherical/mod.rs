@@ -217,11 +217,17 @@ impl SphericalDelaunay {
         tri.engine.reserve(points.len() + 4, 2 * points.len() + 8);
         tri.input_point = vec![PointId::NONE; points.len()];
         let keys: Vec<u64> = points.iter().map(|p| Sphere.spatial_key(p)).collect();
-        for (k, &i) in crate::sort::brio_order(&keys, 0x0b17).iter().enumerate() {
+        // gathered in insertion order first: independent loads overlap, where a load inside
+        // the insertion loop stalls it (a tenth of the build at 10⁶ points)
+        let sorted: Vec<(u32, [f64; 3])> = crate::sort::brio_order(&keys, 0x0b17)
+            .into_iter()
+            .map(|i| (i, points[i as usize]))
+            .collect();
+        for (k, &(i, p)) in sorted.iter().enumerate() {
             if k % 4096 == 0 && progress(k).is_break() {
                 return Err(Error::Interrupted);
             }
-            tri.insert_checked(InputId(i), points[i as usize]);
+            tri.insert_checked(InputId(i), p);
         }
         if progress(points.len()).is_break() {
             return Err(Error::Interrupted);
