@@ -74,30 +74,4 @@ PY
         echo "tool=pyvoro2 case=power N=$n rep=$rep $line $stamp"
     done
 done | tee -a "$raw"
-python3 - "$raw" "${stamp%% *}" <<'PY'
-import statistics, sys
-from collections import defaultdict
-commit = sys.argv[2].split("=")[1]
-runs = defaultdict(list)
-for line in open(sys.argv[1]):
-    d = {}
-    for kv in line.split():
-        if "=" in kv:
-            k, v = kv.split("=", 1)
-            d.setdefault(k, v)
-    if d.get("commit") != commit:
-        continue
-    name = d.get("cmd", "orbitri")
-    if d["tool"] == "orbitri" and d["case"] == "power":
-        t = float(d["build_seconds"]) + float(d["voronoi_seconds"])
-        mem = d.get("voronoi_peak_rss_kb")
-    elif d["tool"] == "orbitri":
-        t, mem = float(d["build_seconds"]), d.get("peak_rss_kb")
-    else:
-        t, mem = float(d["time_s"]), d.get("peak_rss_kB")
-    runs[(d["case"], int(d["N"]), name)].append((t, int(mem) if mem and mem.isdigit() else 0, d.get("hidden", d.get("empty", ""))))
-for key in sorted(runs):
-    ts = [r[0] for r in runs[key]]
-    print(f"{key[0]} N={key[1]} {key[2]}: median {statistics.median(ts):.3f} s over {len(ts)} "
-          f"(runs {', '.join(f'{t:.3f}' for t in ts)}), peak {max(r[1] for r in runs[key]) / 1024:.0f} MB, hidden/empty {runs[key][0][2]}")
-PY
+python3 "$root/bench/medians.py" "$raw" "$(git -C "$root" rev-parse --short HEAD)" --voronoi power --extra hidden,empty

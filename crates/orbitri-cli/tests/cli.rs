@@ -1346,3 +1346,88 @@ fn weighted_points_on_the_command_line() {
     assert_eq!(weights.matches("<circle").count(), 3, "{weights}");
     assert_eq!(weights.matches("stroke-dasharray").count(), 0);
 }
+
+/// `orbitri COMMAND INPUT --space sphere EXTRA...`
+fn on_sphere(command: &str, input: &Path, extra: &[&str]) -> Output {
+    let mut args = vec![command, input.to_str().unwrap(), "--space", "sphere"];
+    args.extend_from_slice(extra);
+    orbitri(&args)
+}
+
+#[test]
+fn the_sphere_from_the_command_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
+    // an octahedron with the north pole given twice (lon/lat), and a point off the sphere
+    let ll = write(
+        dir.path(),
+        "ll.csv",
+        "lon,lat\n0,0\n90,0\n180,0\n-90,0\n0,90\n45,90\n0,-90\n",
+    );
+    let o = on_sphere(
+        "triangulate",
+        &ll,
+        &["--lonlat", "--stats", "-o", &path("t.cells")],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("vertices=6 faces=8 dimension=2 covers_sphere=true duplicates=1"));
+    let (header, rows) = cells_file(&std::fs::read_to_string(path("t.cells")).unwrap());
+    assert_eq!(header, vec![1, 6, 8]);
+    // every face is three input ids, the pole as its first occurrence (4), never 5
+    assert!(rows.iter().all(|r| r.len() == 3 && !r.contains(&5)));
+    // the Voronoi table: areas sum to 4π, the duplicate points to its first occurrence
+    let o = on_sphere("voronoi", &ll, &["--lonlat", "-o", &path("v.csv")]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(path("v.csv")).unwrap();
+    let rows: Vec<Vec<&str>> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    assert_eq!(rows.len(), 7);
+    let area: f64 = rows
+        .iter()
+        .filter(|r| r[8].is_empty())
+        .map(|r| r[1].parse::<f64>().unwrap())
+        .sum();
+    assert!((area - 4.0 * std::f64::consts::PI).abs() < 1e-12);
+    assert_eq!(rows[5][8], "4");
+    // JSON, VTU and a picture
+    for (command, name) in [
+        ("voronoi", "v.json"),
+        ("voronoi", "v.vtu"),
+        ("draw", "d.svg"),
+    ] {
+        let o = on_sphere(command, &ll, &["--lonlat", "-o", &path(name)]);
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    assert!(std::fs::read_to_string(path("d.svg"))
+        .unwrap()
+        .contains("id=\"voronoi\""));
+    // points off the sphere: an error, or normalized on request (three points: one plane)
+    let off = write(dir.path(), "off.txt", "1 0 0\n0 1 0\n0 0 1.5\n");
+    let o = on_sphere("triangulate", &off, &[]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("point 2: its norm is 1.5"),
+        "{}",
+        stderr(&o)
+    );
+    let o = on_sphere(
+        "triangulate",
+        &off,
+        &["--normalize", "--stats", "-o", &path("n.cells")],
+    );
+    assert!(stderr(&o).contains("dimension=1"), "{}", stderr(&o));
+    // a hemisphere has no Voronoi diagram of its faces alone: a typed error
+    let o = on_sphere("voronoi", &off, &["--normalize"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("hemisphere"), "{}", stderr(&o));
+    // a box given to the sphere, --lonlat given to a torus, a torus without its box
+    let o = on_sphere("triangulate", &off, &["--box", "1", "1", "1"]);
+    assert!(stderr(&o).contains("has no box"), "{}", stderr(&o));
+    let o = triangulate_cube(&off, &["--lonlat"]);
+    assert!(stderr(&o).contains("for --space sphere"), "{}", stderr(&o));
+    let o = orbitri(&["triangulate", off.to_str().unwrap()]);
+    assert!(stderr(&o).contains("needs its domain"), "{}", stderr(&o));
+}

@@ -33,6 +33,8 @@ use pyo3::prelude::*;
 use pyo3::sync::RwLockExt;
 use pyo3::types::PyDict;
 
+mod sphere;
+
 fn value_error(e: orbitri::Error) -> PyErr {
     PyValueError::new_err(e.to_string())
 }
@@ -1296,6 +1298,8 @@ fn _orbitri(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Triangulation>()?;
     m.add_class::<Voronoi>()?;
     m.add_class::<Space>()?;
+    m.add_class::<sphere::SphericalTriangulation>()?;
+    m.add_class::<sphere::SphericalVoronoi>()?;
     m.add("PLATYCOSMS", FlatManifold::PLATYCOSMS.to_vec())?;
     Ok(())
 }

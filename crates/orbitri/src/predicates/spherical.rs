@@ -61,7 +61,7 @@ fn orient_exact(rows: [[f64; 3]; 3]) -> Sign {
 
 /// The side of `q` of the plane through `a, b, c` (positively oriented): `Positive` when
 /// `q` is inside their circumcircle on the sphere (away from the origin), `Zero` on it.
-/// Anchors are taken symbolically ([`anchored_side`]); when the filter decides, the
+/// Anchors are taken symbolically (order by order in `δ`); when the filter decides, the
 /// infinitesimal terms are below its error bound and cannot change the sign.
 #[inline]
 pub fn side_of_circle(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3], q: &[f64; 3]) -> Sign {

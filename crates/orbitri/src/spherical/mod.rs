@@ -243,6 +243,26 @@ impl SphericalDelaunay {
         Ok(self.insert_checked(i, p))
     }
 
+    /// Inserts a batch of points, all or nothing: every row is checked first (an error
+    /// names it by its row and changes nothing), then they go in by BRIO + Hilbert order.
+    /// Input ids follow the rows' order. Returns what became of each.
+    pub fn insert_all(&mut self, points: &[[f64; 3]]) -> Result<Vec<Status>> {
+        let first = self.input_point.len();
+        for (k, p) in points.iter().enumerate() {
+            check_point(first + k, p)?;
+        }
+        self.input_point.resize(first + points.len(), PointId::NONE);
+        let keys: Vec<u64> = points.iter().map(|p| Sphere.spatial_key(p)).collect();
+        for k in crate::sort::brio_order(&keys, 0x0b17 ^ first as u64) {
+            let k = k as usize;
+            self.insert_checked(InputId::new(first + k), points[k]);
+        }
+        // (statuses as they are now: a later point may have hidden an earlier one)
+        Ok((first..first + points.len())
+            .map(|i| self.status(InputId::new(i)).expect("just inserted"))
+            .collect())
+    }
+
     /// Inserts input `i` (its slot in `input_point` exists) at the checked point `p`.
     fn insert_checked(&mut self, i: InputId, p: [f64; 3]) -> Status {
         match self.engine.insert(p) {
@@ -350,6 +370,25 @@ impl SphericalDelaunay {
                 self.hidden.remove(&j);
                 self.insert_checked(j, x);
             }
+        }
+        Ok(())
+    }
+
+    /// Removes the inputs `ids`, in that order, all or nothing: an unknown, removed or
+    /// repeated id is an error naming it, and nothing changes.
+    pub fn remove_all(&mut self, ids: &[InputId]) -> Result<()> {
+        let mut seen = std::collections::HashSet::with_capacity(ids.len());
+        for &i in ids {
+            self.live(i)?;
+            if !seen.insert(i) {
+                return Err(Error::UnknownInput {
+                    id: i.0 as u64,
+                    why: "is given twice".into(),
+                });
+            }
+        }
+        for &i in ids {
+            self.remove(i)?;
         }
         Ok(())
     }
