@@ -17,6 +17,7 @@ pub use flat_manifold::{Coset, FlatManifold, Motion};
 pub use flat_torus::{FlatTorus, FlatTorus2, FlatTorus3, Offset3};
 pub(crate) use lattice::ldexp;
 pub use lattice::{Ladder, Lattice, Level, MAX_COPIES, MAX_DEFECT};
+pub(crate) use sphere::sphere_key;
 pub use sphere::{pole, Sphere};
 pub use sublattice::Sublattice;
 

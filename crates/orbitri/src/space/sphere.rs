@@ -4,7 +4,7 @@
 //! triangulation for points on the unit sphere, the regular triangulation on the sphere for
 //! points near it: a point strictly inside the hull of the others is hidden).
 //!
-//! Four anchors `δ·tᵢ` (a regular tetrahedron shrunk to the centre, `δ` infinitesimal, see
+//! Four anchors `δ·tᵢ` (a tetrahedron around the centre shrunk to it, `δ` infinitesimal, see
 //! [`spherical::side_of_circle`]) keep the centre strictly inside the hull of any point set,
 //! so that one point, three points or a hemisphere are triangulations too: the cells free
 //! of anchors are exactly the faces of the hull that have the centre strictly on their
@@ -15,22 +15,78 @@ use super::{Lifted, OrbitSpace};
 use crate::predicates::spherical::{self, ANCHOR_SCALE};
 use crate::predicates::Sign;
 
-/// The unit sphere S².
+/// The unit sphere S², with its set of anchors ([`Sphere::with_anchors`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Sphere;
+pub struct Sphere {
+    anchor_set: u64,
+}
+
+impl Sphere {
+    /// The sphere with the anchor set `k`: four integer directions `tᵢ` (coordinates below
+    /// 2²², in general position, `t₃ = −(t₀ + t₁ + t₂)` so that the centre is their
+    /// centroid) drawn from a generator seeded with `k`. A point exactly along an anchor's
+    /// direction would make a flat cell with it, which no perturbation separates; the
+    /// facade picks a set that no point meets ([`Sphere::meets_anchor`]).
+    pub fn with_anchors(k: u64) -> Sphere {
+        Sphere { anchor_set: k }
+    }
+
+    /// The number of the anchor set.
+    pub fn anchor_set(&self) -> u64 {
+        self.anchor_set
+    }
+
+    /// The anchors' directions (integers, exact as doubles).
+    pub fn anchor_directions(&self) -> [[f64; 3]; 4] {
+        let mut r = crate::sort::SplitMix::new(0xa9c4_0000 ^ self.anchor_set);
+        loop {
+            let mut v = [[0.0; 3]; 4];
+            for t in v.iter_mut().take(3) {
+                *t = std::array::from_fn(|_| r.below(1 << 22) as f64 - (1 << 21) as f64);
+            }
+            v[3] = std::array::from_fn(|k| -(v[0][k] + v[1][k] + v[2][k]));
+            // (spanning, and no two along one line: then no three coplanar with the centre
+            // either, as each triple spans with the fourth)
+            let independent = (0..4).all(|i| {
+                let [a, b, c] = [v[(i + 1) % 4], v[(i + 2) % 4], v[(i + 3) % 4]];
+                spherical::orient_origin(&a, &b, &c) != Sign::Zero
+            });
+            if independent {
+                return v;
+            }
+        }
+    }
+
+    /// True when `p` lies exactly along (or against) one of the anchors' directions.
+    pub fn meets_anchor(&self, p: &[f64; 3]) -> bool {
+        let axes = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        self.anchor_directions().iter().any(|t| {
+            // |p × t| is small first (cheap), then zero exactly: det[p; t; e_k] = 0 for all k
+            let n = cross(p, t);
+            dot(&n, &n) <= 1e-12 * dot(p, p) * dot(t, t)
+                && axes
+                    .iter()
+                    .all(|e| spherical::orient_origin(p, t, e) == Sign::Zero)
+        })
+    }
+}
 
 /// A lifted point of the sphere (the group is trivial).
 type L = Lifted<[f64; 3], ()>;
 
-/// `(b − a) × (c − a)`.
-fn normal(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> [f64; 3] {
-    let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-    let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+fn cross(u: &[f64; 3], v: &[f64; 3]) -> [f64; 3] {
     [
         u[1] * v[2] - u[2] * v[1],
         u[2] * v[0] - u[0] * v[2],
         u[0] * v[1] - u[1] * v[0],
     ]
+}
+
+/// `(b − a) × (c − a)`.
+fn normal(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> [f64; 3] {
+    let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+    cross(&u, &v)
 }
 
 fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
@@ -75,14 +131,6 @@ fn tie(s: &[L; 3], q: L) -> Sign {
         Sign::from(pts[i].partial_cmp(&pts[j]).expect("finite coordinates"))
     })
 }
-
-/// The regular tetrahedron of the anchors, shrunk to `2⁻¹⁰⁰⁰`.
-const ANCHORS: [[f64; 3]; 4] = [
-    [ANCHOR_SCALE, ANCHOR_SCALE, ANCHOR_SCALE],
-    [ANCHOR_SCALE, -ANCHOR_SCALE, -ANCHOR_SCALE],
-    [-ANCHOR_SCALE, ANCHOR_SCALE, -ANCHOR_SCALE],
-    [-ANCHOR_SCALE, -ANCHOR_SCALE, ANCHOR_SCALE],
-];
 
 impl OrbitSpace<3> for Sphere {
     type Point = [f64; 3];
@@ -220,7 +268,12 @@ impl OrbitSpace<3> for Sphere {
     const HIDES: bool = true;
 
     fn anchors(&self) -> Vec<[f64; 3]> {
-        ANCHORS.to_vec()
+        // (the directions are integers below 2²³: scaled by 2⁻¹⁰⁰⁰ exactly, and far below
+        // the 2⁻⁹⁰⁰ that marks an anchor)
+        self.anchor_directions()
+            .iter()
+            .map(|t| t.map(|x| x * ANCHOR_SCALE / (1u64 << 23) as f64))
+            .collect()
     }
 
     fn anchor_cells(&self) -> Vec<[(u32, ()); 3]> {
@@ -252,7 +305,7 @@ mod tests {
 
     #[test]
     fn anchors_alone_are_a_valid_sphere() {
-        let e = Engine::new(Sphere);
+        let e = Engine::new(Sphere::default());
         e.is_valid().unwrap();
         assert_eq!(e.number_of_cells(), 4);
         assert_eq!(e.number_of_points(), 0);
@@ -260,7 +313,7 @@ mod tests {
 
     #[test]
     fn random_points_hide_every_anchor() {
-        let mut e = Engine::new(Sphere);
+        let mut e = Engine::new(Sphere::default());
         let mut r = SplitMix::new(1);
         for k in 0..500 {
             e.insert(unit(&mut r));
@@ -272,6 +325,21 @@ mod tests {
         assert!((0..4).all(|a| e.is_hidden_anchor(crate::ids::PointId(a))));
         // a triangulated sphere: 2V − 4 faces
         assert_eq!(e.number_of_cells(), 2 * 500 - 4);
+    }
+
+    #[test]
+    fn anchors_enclose_the_centre_and_points_along_them_are_detected() {
+        for k in 0..20 {
+            let s = Sphere::with_anchors(k);
+            let t = s.anchor_directions();
+            // the centre is strictly inside: each face turns its outer side away from it
+            let e = Engine::new(s);
+            e.is_valid().unwrap();
+            assert_eq!(e.number_of_cells(), 4);
+            assert!(s.meets_anchor(&t[1].map(|x| x * 0.5f64.powi(22))));
+            assert!(s.meets_anchor(&t[2].map(|x| -x)));
+            assert!(!s.meets_anchor(&[0.0, 0.0, 1.0]));
+        }
     }
 
     #[test]

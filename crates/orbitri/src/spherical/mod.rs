@@ -25,7 +25,7 @@ use crate::error::{Error, Result};
 use crate::ids::{CellId, InputId, PointId, VertexId};
 use crate::predicates::spherical::{orient_origin, side_of_circle};
 use crate::predicates::Sign;
-use crate::space::{OrbitSpace, Sphere};
+use crate::space::{sphere_key, Sphere};
 
 /// How far `|p|²` may be from 1 for a point given as on the unit sphere (doubles rarely
 /// are exactly): about single precision, so that a wrong column or unnormalized vectors
@@ -115,6 +115,14 @@ pub fn normalized(points: &[[f64; 3]]) -> Result<Vec<[f64; 3]>> {
         .collect()
 }
 
+/// The sphere with the first anchor set that none of `points` meets.
+fn anchors_for<'a>(points: impl Iterator<Item = &'a [f64; 3]> + Clone) -> Sphere {
+    (0..)
+        .map(Sphere::with_anchors)
+        .find(|s| !points.clone().any(|p| s.meets_anchor(p)))
+        .expect("each point meets at most one set")
+}
+
 fn check_finite(index: usize, p: &[f64; 3]) -> Result<()> {
     match p.iter().position(|x| !x.is_finite()) {
         Some(axis) => Err(Error::NonFiniteCoordinate {
@@ -162,7 +170,12 @@ impl Default for SphericalDelaunay {
 impl SphericalDelaunay {
     /// An empty triangulation.
     pub fn new() -> Self {
-        let engine = Engine::new(Sphere);
+        Self::with_space(Sphere::default())
+    }
+
+    /// An empty triangulation with the anchors of `space`.
+    fn with_space(space: Sphere) -> Self {
+        let engine = Engine::new(space);
         let anchors = engine.points().len();
         SphericalDelaunay {
             engine,
@@ -213,10 +226,10 @@ impl SphericalDelaunay {
         for (i, p) in points.iter().enumerate() {
             check_point(i, p)?;
         }
-        let mut tri = Self::new();
+        let mut tri = Self::with_space(anchors_for(points.iter()));
         tri.engine.reserve(points.len() + 4, 2 * points.len() + 8);
         tri.input_point = vec![PointId::NONE; points.len()];
-        let keys: Vec<u64> = points.iter().map(|p| Sphere.spatial_key(p)).collect();
+        let keys: Vec<u64> = points.iter().map(sphere_key).collect();
         // gathered in insertion order first: independent loads overlap, where a load inside
         // the insertion loop stalls it (a tenth of the build at 10⁶ points)
         let sorted: Vec<(u32, [f64; 3])> = crate::sort::brio_order(&keys, 0x0b17)
@@ -238,6 +251,9 @@ impl SphericalDelaunay {
     /// Inserts one more point (its input id is the number of points given so far).
     pub fn insert(&mut self, p: [f64; 3]) -> Result<Status> {
         check_point(self.input_point.len(), &p)?;
+        if self.engine.space().meets_anchor(&p) {
+            self.reanchor(&[p]);
+        }
         let i = InputId::new(self.input_point.len());
         self.input_point.push(PointId::NONE);
         Ok(self.insert_checked(i, p))
@@ -251,8 +267,11 @@ impl SphericalDelaunay {
         for (k, p) in points.iter().enumerate() {
             check_point(first + k, p)?;
         }
+        if points.iter().any(|p| self.engine.space().meets_anchor(p)) {
+            self.reanchor(points);
+        }
         self.input_point.resize(first + points.len(), PointId::NONE);
-        let keys: Vec<u64> = points.iter().map(|p| Sphere.spatial_key(p)).collect();
+        let keys: Vec<u64> = points.iter().map(sphere_key).collect();
         for k in crate::sort::brio_order(&keys, 0x0b17 ^ first as u64) {
             let k = k as usize;
             self.insert_checked(InputId::new(first + k), points[k]);
@@ -261,6 +280,22 @@ impl SphericalDelaunay {
         Ok((first..first + points.len())
             .map(|i| self.status(InputId::new(i)).expect("just inserted"))
             .collect())
+    }
+
+    /// Triangulates the points again with anchors that neither they nor `more` meet (a
+    /// point along an anchor's direction: rare, but exactly possible). Input ids stay.
+    fn reanchor(&mut self, more: &[[f64; 3]]) {
+        let live: Vec<(InputId, [f64; 3])> = (0..self.input_point.len())
+            .map(InputId::new)
+            .filter_map(|i| self.point(i).map(|p| (i, p)))
+            .collect();
+        let space = anchors_for(live.iter().map(|x| &x.1).chain(more));
+        let n = self.input_point.len();
+        *self = Self::with_space(space);
+        self.input_point = vec![PointId::NONE; n];
+        for (i, p) in live {
+            self.insert_checked(i, p);
+        }
     }
 
     /// Inserts input `i` (its slot in `input_point` exists) at the checked point `p`.
@@ -588,4 +623,39 @@ fn collinear(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> bool {
     [[0.0; 3], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0], [0.0, 0.0, 4.0]]
         .iter()
         .all(|q| side_of_circle(a, b, c, q) == Sign::Zero)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sort::SplitMix;
+
+    #[test]
+    fn anchors_are_chosen_away_from_the_points() {
+        // points exactly along two directions of the first set, coordinates within the
+        // unit bound of the sphere's static filters (the facade's norm check would refuse
+        // them, so the engine takes them directly)
+        let t = Sphere::default().anchor_directions();
+        let mut pts = vec![
+            t[0].map(|x| x * 0.5f64.powi(21)),
+            t[3].map(|x| -x * 0.5f64.powi(23)),
+        ];
+        let mut r = SplitMix::new(8);
+        for _ in 0..200 {
+            let v = [r.unit() - 0.5, r.unit() - 0.5, r.unit() - 0.5];
+            let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+            pts.push(v.map(|x| x / n));
+        }
+        let space = anchors_for(pts.iter());
+        assert_ne!(space.anchor_set(), 0);
+        assert!(pts.iter().all(|p| !space.meets_anchor(p)));
+        let mut e = Engine::new(space);
+        for p in &pts {
+            e.insert(*p);
+        }
+        e.is_valid().unwrap();
+        // (the two short points lie inside the hull of the unit ones: hidden)
+        assert_eq!(e.number_of_points() + e.hidden_log.len(), 202);
+        assert!(!Sphere::default().meets_anchor(&pts[5]));
+    }
 }

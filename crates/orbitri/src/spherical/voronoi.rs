@@ -9,7 +9,7 @@ use rayon::prelude::*;
 use super::SphericalDelaunay;
 use crate::error::{Error, Result};
 use crate::ids::{CellId, InputId, VertexId};
-use crate::space::{pole, OrbitSpace, Sphere};
+use crate::space::{pole, OrbitSpace};
 
 /// The Voronoi cell of one vertex on the sphere.
 #[derive(Clone, Debug, PartialEq)]
@@ -106,7 +106,9 @@ impl SphericalDelaunay {
                     }
                     let dc = e.cell(d);
                     let j = dc.mirror(c).expect("symmetric neighbours");
-                    Sphere.cospherical(&s, e.lifted(d, j)).then_some((c.0, d.0))
+                    e.space()
+                        .cospherical(&s, e.lifted(d, j))
+                        .then_some((c.0, d.0))
                 })
             })
             .collect();
