@@ -10,6 +10,7 @@ mod lattice;
 mod left_order;
 mod metric;
 mod platycosms;
+mod projective_plane;
 mod sphere;
 mod sublattice;
 
@@ -17,6 +18,7 @@ pub use flat_manifold::{Coset, FlatManifold, Motion};
 pub use flat_torus::{FlatTorus, FlatTorus2, FlatTorus3, Offset3};
 pub(crate) use lattice::ldexp;
 pub use lattice::{Ladder, Lattice, Level, MAX_COPIES, MAX_DEFECT};
+pub use projective_plane::{canonical as projective_representative, Antipode, ProjectivePlane};
 pub(crate) use sphere::sphere_key;
 pub use sphere::{pole, Sphere};
 pub use sublattice::Sublattice;

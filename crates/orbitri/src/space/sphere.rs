@@ -103,6 +103,18 @@ pub fn pole(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> [f64; 3] {
     n.map(|x| x / len)
 }
 
+/// The squared chord from the pole of the positively oriented triangle `s` to its vertex 0
+/// (`2 − 2 cos θ` for the angular radius `θ`), accurate to about `1e-12` absolute; 4 (the
+/// largest) for a cell with an anchor.
+pub(crate) fn circumradius2_of(s: &[[f64; 3]; 3]) -> f64 {
+    if s.iter().any(spherical::is_anchor) {
+        return 4.0;
+    }
+    let n = pole(&s[0], &s[1], &s[2]);
+    let r = dot(&s[0], &s[0]).sqrt();
+    (2.0 - 2.0 * dot(&n, &s[0]) / r).clamp(0.0, 4.0)
+}
+
 /// The key of a point along a space-filling curve over the sphere: the cube face its
 /// direction passes through (3 bits), then the Hilbert index of its gnomonic coordinates on
 /// that face (16 bits per axis: far finer than a sort needs, and half the work of 30).
@@ -167,17 +179,9 @@ impl OrbitSpace<3> for Sphere {
         a.0 == b.0
     }
 
-    /// The squared chord from the pole of the cell to its vertex 0 (`2 − 2 cos θ` for the
-    /// angular radius `θ`), accurate to about `1e-12` absolute; 4 (the largest) for a cell
-    /// with an anchor.
+    /// [`circumradius2_of`] the cell.
     fn circumradius2(&self, s: &[L; 3]) -> f64 {
-        if s.iter().any(|x| spherical::is_anchor(&x.0)) {
-            return 4.0;
-        }
-        let n = pole(&s[0].0, &s[1].0, &s[2].0);
-        let a = s[0].0;
-        let r = dot(&a, &a).sqrt();
-        (2.0 - 2.0 * dot(&n, &a) / r).clamp(0.0, 4.0)
+        circumradius2_of(&[s[0].0, s[1].0, s[2].0])
     }
 
     /// The sphere carries no weights (its triangulations are never weighted): this is the
