@@ -179,7 +179,7 @@ impl OrbitSpace<3> for Sphere {
         a.0 == b.0
     }
 
-    /// [`circumradius2_of`] the cell.
+    /// The squared chord from the cell's pole to its vertex 0 (4 for a cell with an anchor).
     fn circumradius2(&self, s: &[L; 3]) -> f64 {
         circumradius2_of(&[s[0].0, s[1].0, s[2].0])
     }
