@@ -321,11 +321,22 @@ fn bad_input_is_a_typed_error() {
 }
 
 #[test]
-fn lonlat_is_exact_at_the_poles_and_axes() {
+fn lonlat_is_exact_at_the_poles_the_axes_and_antipodes() {
     assert_eq!(lonlat_to_point(0, 0.0, 90.0).unwrap(), [0.0, 0.0, 1.0]);
     assert_eq!(lonlat_to_point(0, 123.0, -90.0).unwrap()[2], -1.0);
     assert_eq!(lonlat_to_point(0, 90.0, 0.0).unwrap(), [0.0, 1.0, 0.0]);
     assert_eq!(lonlat_to_point(0, -180.0, 0.0).unwrap(), [-1.0, 0.0, 0.0]);
+    // antipodes exactly: (λ + 180, −φ) ↦ −p (longitudes in 1/1024 degrees: λ + 180 exact)
+    let mut r = SplitMix::new(3);
+    for _ in 0..1000 {
+        let lon = (r.unit() * 360.0 * 1024.0).round() / 1024.0 - 180.0;
+        let lat = r.unit() * 180.0 - 90.0;
+        let p = lonlat_to_point(0, lon, lat).unwrap();
+        assert_eq!(
+            lonlat_to_point(0, lon + 180.0, -lat).unwrap(),
+            p.map(|x| -x)
+        );
+    }
     let p = lonlat_to_point(0, 30.0, 45.0).unwrap();
     let back = orbitri::spherical::point_to_lonlat(&p);
     assert!((back[0] - 30.0).abs() < 1e-12 && (back[1] - 45.0).abs() < 1e-12);

@@ -22,10 +22,12 @@ use std::ops::ControlFlow;
 
 use crate::delaunay::{Engine, Inserted, Invalid};
 use crate::error::{Error, Result};
-use crate::ids::{CellId, InputId, PointId, VertexId};
+use crate::ids::{CellId, InputId, PointId};
 use crate::predicates::spherical::{orient_origin, side_of_circle};
 use crate::predicates::Sign;
-use crate::space::{sphere_key, Sphere};
+use crate::space::{
+    projective_representative, sphere_key, Antipode, OrbitSpace, ProjectivePlane, Sphere,
+};
 
 /// How far `|p|²` may be from 1 for a point given as on the unit sphere (doubles rarely
 /// are exactly): about single precision, so that a wrong column or unnormalized vectors
@@ -65,23 +67,26 @@ pub fn lonlat_to_point(index: usize, lon: f64, lat: f64) -> Result<[f64; 3]> {
             limit: "must lie within [-90, 90] degrees".into(),
         });
     }
-    let (l, f) = (lon.to_radians(), lat.to_radians());
-    // exact poles and equator points where the trigonometry would leave 6e-17
-    let (sf, cf) = match lat {
-        90.0 => (1.0, 0.0),
-        -90.0 => (-1.0, 0.0),
+    // antipodes exactly: `(λ + 180, −φ)` gives the negated vector (the longitude reduced
+    // to [0, 180) and its half turn applied as a sign; the latitude's sign applied after)
+    let r = lon.rem_euclid(360.0);
+    let (r, turn) = if r >= 180.0 {
+        (r - 180.0, -1.0)
+    } else {
+        (r, 1.0)
+    };
+    let (sl, cl) = match r {
         0.0 => (0.0, 1.0),
-        _ => f.sin_cos(),
+        90.0 => (1.0, 0.0),
+        _ => r.to_radians().sin_cos(),
     };
-    let (sl, cl) = match lon.rem_euclid(90.0) {
-        0.0 => match (lon.rem_euclid(360.0) / 90.0) as u8 {
-            0 => (0.0, 1.0),
-            1 => (1.0, 0.0),
-            2 => (0.0, -1.0),
-            _ => (-1.0, 0.0),
-        },
-        _ => l.sin_cos(),
+    let (sf, cf) = match lat.abs() {
+        90.0 => (1.0, 0.0),
+        0.0 => (0.0, 1.0),
+        a => a.to_radians().sin_cos(),
     };
+    let sf = if lat < 0.0 { -sf } else { sf };
+    let (sl, cl) = (turn * sl, turn * cl);
     Ok([cf * cl, cf * sl, sf])
 }
 
@@ -115,10 +120,78 @@ pub fn normalized(points: &[[f64; 3]]) -> Result<Vec<[f64; 3]>> {
         .collect()
 }
 
-/// The sphere with the first anchor set that none of `points` meets.
-fn anchors_for<'a>(points: impl Iterator<Item = &'a [f64; 3]> + Clone) -> Sphere {
+/// A space of this facade: the sphere, or the projective plane (the sphere modulo ±1).
+pub trait SphericalSpace:
+    OrbitSpace<3, Point = [f64; 3]> + Copy + Default + std::fmt::Debug + 'static
+{
+    /// The space with the anchor set `k` (see [`Sphere::with_anchors`]).
+    fn with_anchors(k: u64) -> Self;
+    /// True when `p` lies exactly along an anchor's direction.
+    fn meets_anchor(&self, p: &[f64; 3]) -> bool;
+    /// The stored representative of a point of the sphere.
+    fn representative(p: [f64; 3]) -> [f64; 3];
+    /// The position of a lifted point on the sphere.
+    fn position(p: [f64; 3], g: Self::Elem) -> [f64; 3];
+    /// Whether a group element takes points to their antipodes (never on the sphere).
+    fn is_antipode(g: Self::Elem) -> bool;
+    /// The area of the space: 4π, 2π.
+    const AREA: f64;
+}
+
+impl SphericalSpace for Sphere {
+    fn with_anchors(k: u64) -> Self {
+        Sphere::with_anchors(k)
+    }
+    fn meets_anchor(&self, p: &[f64; 3]) -> bool {
+        Sphere::meets_anchor(self, p)
+    }
+    fn representative(p: [f64; 3]) -> [f64; 3] {
+        p
+    }
+    fn position(p: [f64; 3], _: ()) -> [f64; 3] {
+        p
+    }
+    fn is_antipode(_: ()) -> bool {
+        false
+    }
+    const AREA: f64 = 4.0 * std::f64::consts::PI;
+}
+
+impl SphericalSpace for ProjectivePlane {
+    fn with_anchors(k: u64) -> Self {
+        ProjectivePlane::with_anchors(k)
+    }
+    fn meets_anchor(&self, p: &[f64; 3]) -> bool {
+        ProjectivePlane::meets_anchor(self, p)
+    }
+    fn representative(p: [f64; 3]) -> [f64; 3] {
+        projective_representative(&p)
+    }
+    fn position(p: [f64; 3], g: Antipode) -> [f64; 3] {
+        if g.0 {
+            p.map(|x| -x)
+        } else {
+            p
+        }
+    }
+    fn is_antipode(g: Antipode) -> bool {
+        g.0
+    }
+    const AREA: f64 = 2.0 * std::f64::consts::PI;
+}
+
+/// The Delaunay triangulation of points on the unit sphere.
+pub type SphericalDelaunay = SphericalTriangulation<Sphere>;
+
+/// The triangulation of the real projective plane RP² = S²/{±1}: points `p` and `−p` are
+/// one point (a duplicate), faces are listed with the sign of each vertex
+/// ([`SphericalTriangulation::face_signs`]).
+pub type ProjectiveDelaunay = SphericalTriangulation<ProjectivePlane>;
+
+/// The space with the first anchor set that none of `points` meets.
+fn anchors_for<'a, S: SphericalSpace>(points: impl Iterator<Item = &'a [f64; 3]> + Clone) -> S {
     (0..)
-        .map(Sphere::with_anchors)
+        .map(S::with_anchors)
         .find(|s| !points.clone().any(|p| s.meets_anchor(p)))
         .expect("each point meets at most one set")
 }
@@ -147,10 +220,11 @@ fn check_point(index: usize, p: &[f64; 3]) -> Result<()> {
     Ok(())
 }
 
-/// The Delaunay triangulation of points on the unit sphere.
+/// The Delaunay triangulation of points on the unit sphere ([`SphericalDelaunay`]), or of
+/// the real projective plane ([`ProjectiveDelaunay`]): one facade for both.
 #[derive(Debug)]
-pub struct SphericalDelaunay {
-    engine: Engine<Sphere, 3>,
+pub struct SphericalTriangulation<S: SphericalSpace> {
+    engine: Engine<S, 3>,
     /// Input → its point in the engine (`NONE` once removed, [`HIDDEN`]).
     input_point: Vec<PointId>,
     /// Engine point → the input id of its first occurrence (`NONE` for the anchors).
@@ -161,23 +235,23 @@ pub struct SphericalDelaunay {
     hidden: BTreeMap<InputId, [f64; 3]>,
 }
 
-impl Default for SphericalDelaunay {
+impl<S: SphericalSpace> Default for SphericalTriangulation<S> {
     fn default() -> Self {
         Self::new()
     }
 }
 
-impl SphericalDelaunay {
+impl<S: SphericalSpace> SphericalTriangulation<S> {
     /// An empty triangulation.
     pub fn new() -> Self {
-        Self::with_space(Sphere::default())
+        Self::with_space(S::default())
     }
 
     /// An empty triangulation with the anchors of `space`.
-    fn with_space(space: Sphere) -> Self {
+    fn with_space(space: S) -> Self {
         let engine = Engine::new(space);
         let anchors = engine.points().len();
-        SphericalDelaunay {
+        SphericalTriangulation {
             engine,
             input_point: Vec::new(),
             point_input: vec![InputId::NONE; anchors],
@@ -226,7 +300,7 @@ impl SphericalDelaunay {
         for (i, p) in points.iter().enumerate() {
             check_point(i, p)?;
         }
-        let mut tri = Self::with_space(anchors_for(points.iter()));
+        let mut tri = Self::with_space(anchors_for::<S>(points.iter()));
         tri.engine.reserve(points.len() + 4, 2 * points.len() + 8);
         tri.input_point = vec![PointId::NONE; points.len()];
         let keys: Vec<u64> = points.iter().map(sphere_key).collect();
@@ -289,7 +363,7 @@ impl SphericalDelaunay {
             .map(InputId::new)
             .filter_map(|i| self.point(i).map(|p| (i, p)))
             .collect();
-        let space = anchors_for(live.iter().map(|x| &x.1).chain(more));
+        let space = anchors_for::<S>(live.iter().map(|x| &x.1).chain(more));
         let n = self.input_point.len();
         *self = Self::with_space(space);
         self.input_point = vec![PointId::NONE; n];
@@ -300,6 +374,7 @@ impl SphericalDelaunay {
 
     /// Inserts input `i` (its slot in `input_point` exists) at the checked point `p`.
     fn insert_checked(&mut self, i: InputId, p: [f64; 3]) -> Status {
+        let p = S::representative(p);
         match self.engine.insert(p) {
             Inserted::New(q) => {
                 // the new point came last, then the points it hid left, the last point
@@ -478,25 +553,35 @@ impl SphericalDelaunay {
 
     /// The dimension of the triangulation as CGAL's `Triangulation_on_sphere_2` gives it:
     /// −2 without vertices, −1 with one, 0 with two, 1 when all vertices lie on one plane
-    /// (one circle of the sphere), 2 otherwise.
+    /// (one circle of the sphere; in RP², one projective line: a great circle), 2
+    /// otherwise.
     pub fn dimension(&self) -> i32 {
-        let pts = &self.engine.points()[self.anchors()..];
-        match pts.len() {
-            0 => -2,
-            1 => -1,
-            2 => 0,
-            _ => {
-                // three distinct points near the sphere are never on one line
-                let (a, b) = (&pts[0], &pts[1]);
-                let Some(c) = pts[2..].iter().find(|c| !collinear(a, b, c)) else {
-                    return 1;
-                };
-                if pts.iter().any(|q| side_of_circle(a, b, c, q) != Sign::Zero) {
-                    2
-                } else {
-                    1
-                }
-            }
+        let reps = &self.engine.points()[self.anchors()..];
+        match reps.len() {
+            0 => return -2,
+            1 => return -1,
+            2 => return 0,
+            _ => {}
+        }
+        let pts: Vec<[f64; 3]> = reps
+            .iter()
+            .flat_map(|&p| {
+                self.engine
+                    .space()
+                    .covering_copies(0)
+                    .into_iter()
+                    .map(move |g| S::position(p, g))
+            })
+            .collect();
+        // three distinct points near the sphere are never on one line
+        let (a, b) = (&pts[0], &pts[1]);
+        let Some(c) = pts[2..].iter().find(|c| !collinear(a, b, c)) else {
+            return 1;
+        };
+        if pts.iter().any(|q| side_of_circle(a, b, c, q) != Sign::Zero) {
+            2
+        } else {
+            1
         }
     }
 
@@ -509,43 +594,82 @@ impl SphericalDelaunay {
 
     /// True for an engine cell with no anchor.
     fn is_face(&self, c: CellId) -> bool {
-        let anchors = self.anchors() as u32;
-        self.engine.cell(c).v.iter().all(|v| v.0 >= anchors)
+        let anchors = self.anchors();
+        let e = &self.engine;
+        e.cell(c)
+            .v
+            .iter()
+            .all(|&v| e.point_of(v).index() >= anchors)
     }
 
     /// The faces (CGAL's solid faces) by input ids of their vertices, counter-clockwise
-    /// seen from outside; none when [`Self::dimension`] is below 2.
+    /// seen from outside (in RP², the lifted face `signs·points`: [`Self::face_signs`]);
+    /// none when [`Self::dimension`] is below 2. One per face of the space, also while the
+    /// projective plane is stored in its covering sphere.
     pub fn faces(&self) -> Vec<[InputId; 3]> {
-        if self.dimension() < 2 {
-            return Vec::new();
-        }
-        self.face_ids()
-            .map(|c| self.engine.cell(c).v.map(|v| self.point_input[v.index()]))
+        let e = &self.engine;
+        self.face_orbits()
+            .0
+            .iter()
+            .map(|&c| e.cell(c).v.map(|v| self.point_input[e.point_of(v).index()]))
             .collect()
     }
 
-    /// The engine cells that are faces.
-    fn face_ids(&self) -> impl Iterator<Item = CellId> + '_ {
-        self.engine.cell_ids().filter(|&c| self.is_face(c))
+    /// Per face of [`Self::faces`], whether each vertex is the antipode of its stored
+    /// point (always false on the sphere). At most one per face is.
+    pub fn face_signs(&self) -> Vec<[bool; 3]> {
+        let e = &self.engine;
+        self.face_orbits()
+            .0
+            .iter()
+            .map(|&c| e.cell(c).off.map(S::is_antipode))
+            .collect()
+    }
+
+    /// The faces of the space (one stored cell per orbit, the copy in the quotient's
+    /// canonical form) and, per stored cell, the index of its orbit (`usize::MAX` for a
+    /// cell with an anchor). Empty below dimension 2.
+    fn face_orbits(&self) -> (Vec<CellId>, Vec<usize>) {
+        let e = &self.engine;
+        let mut orbit = vec![usize::MAX; e.cell_slots()];
+        let mut reps = Vec::new();
+        if self.dimension() < 2 {
+            return (reps, orbit);
+        }
+        let last = e.space().levels() - 1;
+        let mut index: std::collections::HashMap<[(PointId, S::Elem); 3], usize> =
+            std::collections::HashMap::new();
+        for c in e.cell_ids().filter(|&c| self.is_face(c)) {
+            let cell = e.cell(c);
+            let mut off = cell.off;
+            // a covering's copy that is already canonical represents its orbit
+            let canonical = !e.space().normalize(&mut off, last) && off == cell.off;
+            let mut key: [(PointId, S::Elem); 3] =
+                std::array::from_fn(|k| (e.point_of(cell.v[k]), off[k]));
+            key.sort_unstable();
+            let k = *index.entry(key).or_insert_with(|| {
+                reps.push(c);
+                reps.len() - 1
+            });
+            if canonical {
+                reps[k] = c;
+            }
+            orbit[c.index()] = k;
+        }
+        (reps, orbit)
     }
 
     /// For each face of [`Self::faces`], the face across each edge (edge `k` is opposite
     /// vertex `k`), `None` beyond the faces (where the hull turns its outer side to the
     /// centre: the points lie in a hemisphere).
     pub fn neighbors(&self) -> Vec<[Option<usize>; 3]> {
-        if self.dimension() < 2 {
-            return Vec::new();
-        }
-        let mut index = vec![usize::MAX; self.engine.cell_slots()];
-        for (k, c) in self.face_ids().enumerate() {
-            index[c.index()] = k;
-        }
-        self.face_ids()
-            .map(|c| {
+        let (reps, orbit) = self.face_orbits();
+        reps.iter()
+            .map(|&c| {
                 self.engine
                     .cell(c)
                     .n
-                    .map(|d| Some(index[d.index()]).filter(|&k| k != usize::MAX))
+                    .map(|d| Some(orbit[d.index()]).filter(|&k| k != usize::MAX))
             })
             .collect()
     }
@@ -557,14 +681,15 @@ impl SphericalDelaunay {
         if p == HIDDEN {
             return Ok(Vec::new());
         }
-        let mut out: Vec<InputId> = self
-            .engine
-            .neighbours(VertexId(p.0))
+        let e = &self.engine;
+        let mut out: Vec<InputId> = e
+            .neighbours(e.vertex_of_point(p))
             .into_iter()
-            .map(|(v, _)| self.point_input[v.index()])
+            .map(|(v, _)| self.point_input[e.point_of(v).index()])
             .filter(|&j| j != InputId::NONE)
             .collect();
         out.sort_unstable();
+        out.dedup();
         Ok(out)
     }
 
@@ -589,19 +714,20 @@ impl SphericalDelaunay {
                 norm: 0.0,
             });
         }
-        let (c, _) = self.engine.locate(p);
+        let e = &self.engine;
+        let (c, _) = e.locate(S::representative(p));
         Ok(self
             .is_face(c)
-            .then(|| self.engine.cell(c).v.map(|v| self.point_input[v.index()])))
+            .then(|| e.cell(c).v.map(|v| self.point_input[e.point_of(v).index()])))
     }
 
     /// Checks the engine's triangulation (orientation, local Delaunay, Euler
     /// characteristic 2) and that every face holds the centre strictly inside.
     pub fn is_valid(&self) -> std::result::Result<(), Invalid> {
         self.engine.is_valid()?;
-        for c in self.face_ids() {
-            let cell = self.engine.cell(c);
-            let [a, b, d] = cell.v.map(|v| self.engine.points()[v.index()]);
+        let e = &self.engine;
+        for c in e.cell_ids().filter(|&c| self.is_face(c)) {
+            let [a, b, d] = e.lifted_cell(c).map(|(p, g)| S::position(p, g));
             if orient_origin(&a, &b, &d) != Sign::Positive {
                 return Err(Invalid(format!(
                     "face {c} does not face away from the centre"
@@ -612,7 +738,7 @@ impl SphericalDelaunay {
     }
 
     /// The engine (for the Voronoi layer and tests).
-    pub fn engine(&self) -> &Engine<Sphere, 3> {
+    pub fn engine(&self) -> &Engine<S, 3> {
         &self.engine
     }
 }
@@ -646,7 +772,7 @@ mod tests {
             let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
             pts.push(v.map(|x| x / n));
         }
-        let space = anchors_for(pts.iter());
+        let space = anchors_for::<Sphere>(pts.iter());
         assert_ne!(space.anchor_set(), 0);
         assert!(pts.iter().all(|p| !space.meets_anchor(p)));
         let mut e = Engine::new(space);

@@ -6,10 +6,10 @@
 
 use rayon::prelude::*;
 
-use super::SphericalDelaunay;
+use super::{SphericalSpace, SphericalTriangulation};
 use crate::error::{Error, Result};
-use crate::ids::{CellId, InputId, VertexId};
-use crate::space::{pole, OrbitSpace};
+use crate::ids::{CellId, InputId, PointId, VertexId};
+use crate::space::pole;
 
 /// The Voronoi cell of one vertex on the sphere.
 #[derive(Clone, Debug, PartialEq)]
@@ -65,9 +65,10 @@ fn root(parent: &mut [u32], mut x: u32) -> u32 {
     x
 }
 
-impl SphericalDelaunay {
-    /// The Voronoi cell of every vertex, in the order of [`Self::vertices`]. Points in a
-    /// closed hemisphere (see [`Self::covers_sphere`]), or of dimension below 2, are
+impl<S: SphericalSpace> SphericalTriangulation<S> {
+    /// The Voronoi cell of every vertex, in the order of [`Self::vertices`] (in RP², around
+    /// the stored representative of each point; the areas sum to 2π). Points in a closed
+    /// hemisphere (see [`Self::covers_sphere`]), or of dimension below 2, are
     /// [`Error::Hemisphere`].
     ///
     /// ```
@@ -91,6 +92,7 @@ impl SphericalDelaunay {
             });
         }
         let e = self.engine();
+        let sp = e.space();
         let ids: Vec<CellId> = e.cell_ids().collect();
         // faces on one circle: one class, one pole
         let mut parent: Vec<u32> = (0..e.cell_slots() as u32).collect();
@@ -104,11 +106,11 @@ impl SphericalDelaunay {
                     if d < c {
                         return None;
                     }
-                    let dc = e.cell(d);
-                    let j = dc.mirror(c).expect("symmetric neighbours");
-                    e.space()
-                        .cospherical(&s, e.lifted(d, j))
-                        .then_some((c.0, d.0))
+                    let j = e.cell(d).mirror(c).expect("symmetric neighbours");
+                    // the opposite vertex carried into this cell's frame
+                    let (q, g) = e.lifted(d, j);
+                    let q = (q, sp.compose(e.translation(c, k, d), g));
+                    sp.cospherical(&s, q).then_some((c.0, d.0))
                 })
             })
             .collect();
@@ -119,43 +121,64 @@ impl SphericalDelaunay {
         for c in 0..parent.len() as u32 {
             root(&mut parent, c);
         }
-        let mut poles = vec![[0.0; 3]; e.cell_slots()];
+        // each cell's pole in its own frame; a class shares its root's, up to the antipode
+        // between frames (the one of the two that the cell's own pole is near)
+        let own = |c: CellId| {
+            let [a, b, d] = e.lifted_cell(c).map(|(p, g)| S::position(p, g));
+            pole(&a, &b, &d)
+        };
         let computed: Vec<(CellId, [f64; 3])> = ids
             .par_iter()
-            .filter(|c| parent[c.index()] == c.0)
             .map(|&c| {
-                let [a, b, d] = e.lifted_cell(c).map(|x| x.0);
-                (c, pole(&a, &b, &d))
+                let mine = own(c);
+                let r = CellId(parent[c.index()]);
+                if r == c {
+                    return (c, mine);
+                }
+                let theirs = own(r);
+                let flip = dot(&mine, &theirs) < 0.0;
+                (c, theirs.map(|x| if flip { -x } else { x }))
             })
             .collect();
+        let mut poles = vec![[0.0; 3]; e.cell_slots()];
         for (c, p) in computed {
             poles[c.index()] = p;
         }
         let anchors = self.point_input.len() - self.number_of_vertices();
         Ok((anchors..self.point_input.len())
             .into_par_iter()
-            .map(|p| self.cell_of(VertexId::new(p), &parent, &poles))
+            .map(|p| self.cell_of(e.vertex_of_point(PointId::new(p)), &parent, &poles))
             .collect())
     }
 
-    /// The cell of vertex `v`: the classes of the faces around it, counter-clockwise.
+    /// The cell of vertex `v`: the classes of the faces around it, counter-clockwise seen
+    /// from outside in `v`'s frame. A face whose frame is the antipode of `v`'s is
+    /// reflected there: its pole negated, its turn around `v` the other way.
     fn cell_of(&self, v: VertexId, class: &[u32], poles: &[[f64; 3]]) -> SphericalCell {
         let e = self.engine();
-        let mut ring: Vec<(u32, InputId)> = Vec::new();
+        // (class, the site across the arc to the next, the pole in v's frame)
+        let mut ring: Vec<(u32, InputId, [f64; 3])> = Vec::new();
         let start = e.vcell[v.index()];
         let mut c = start;
         loop {
             let cell = e.cell(c);
             let i = cell.index_of(v).expect("the star holds its vertex");
-            // the next face counter-clockwise shares the edge to the vertex after next
-            let x = cell.v[(i + 2) % 3];
+            let flip = S::is_antipode(cell.off[i]);
+            let (a, b) = if flip {
+                ((i + 2) % 3, (i + 1) % 3)
+            } else {
+                ((i + 1) % 3, (i + 2) % 3)
+            };
+            // the next face counter-clockwise shares the edge to `b`
+            let x = self.point_input[e.point_of(cell.v[b]).index()];
             let k = class[c.index()];
             if ring.last().map(|r| r.0) == Some(k) {
-                ring.last_mut().expect("non-empty").1 = self.point_input[x.index()];
+                ring.last_mut().expect("non-empty").1 = x;
             } else {
-                ring.push((k, self.point_input[x.index()]));
+                let p = poles[c.index()];
+                ring.push((k, x, if flip { p.map(|y| -y) } else { p }));
             }
-            c = cell.n[(i + 1) % 3];
+            c = cell.n[a];
             if c == start {
                 break;
             }
@@ -164,8 +187,8 @@ impl SphericalDelaunay {
         if ring.len() > 1 && ring[0].0 == ring[ring.len() - 1].0 {
             ring.pop();
         }
-        let site = unit(e.points()[v.index()]);
-        let vertices: Vec<[f64; 3]> = ring.iter().map(|r| poles[r.0 as usize]).collect();
+        let site = unit(e.points()[e.point_of(v).index()]);
+        let vertices: Vec<[f64; 3]> = ring.iter().map(|r| r.2).collect();
         let m = vertices.len();
         let (mut area, mut moment) = (0.0, [0.0; 3]);
         let mut arc_lengths = Vec::with_capacity(m);
@@ -183,7 +206,7 @@ impl SphericalDelaunay {
             }
         }
         SphericalCell {
-            site: self.point_input[v.index()],
+            site: self.point_input[e.point_of(v).index()],
             neighbors: ring.iter().map(|r| r.1).collect(),
             vertices,
             arc_lengths,
