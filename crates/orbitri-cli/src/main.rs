@@ -20,7 +20,7 @@ use orbitri::{BuildOptions, FlatManifold, FlatSpace, FlatTorus2, FlatTorus3, Tri
 #[command(
     name = "orbitri",
     version,
-    about = "Exact periodic Delaunay triangulations (2D and 3D flat tori with any lattice, the Klein bottle, the flat 3-manifolds)"
+    about = "Exact Delaunay triangulations in orbit spaces (2D and 3D flat tori with any lattice, the Klein bottle, the flat 3-manifolds, the sphere, the projective plane)"
 )]
 struct Cli {
     #[command(subcommand)]
@@ -147,14 +147,15 @@ enum Command {
 /// (`FlatManifold::PLATYCOSMS`).
 const TORUS_AND_KLEIN: [&str; 2] = ["torus", "klein"];
 /// The spaces without a box.
-const SPHERES: [&str; 1] = ["sphere"];
+const SPHERES: [&str; 2] = ["sphere", "projective-plane"];
 
 #[derive(Args)]
 struct Domain {
     /// The orbit space: a flat torus (default), the Klein bottle (2D: --box L1 L2, the glide
     /// along the first axis), a closed flat 3-manifold (--box L1 L2 L3, the sides of its
-    /// standard domain), or the unit sphere (no box: points are unit vectors `x y z`, or
-    /// with --lonlat longitude and latitude in degrees)
+    /// standard domain), the unit sphere or the real projective plane (the sphere with
+    /// antipodes identified; no box: points are unit vectors `x y z`, or with --lonlat
+    /// longitude and latitude in degrees)
     #[arg(long, value_name = "NAME", default_value = "torus", value_parser = PossibleValuesParser::new(TORUS_AND_KLEIN.into_iter().chain(FlatManifold::PLATYCOSMS).chain(SPHERES)))]
     space: String,
     #[command(flatten)]
@@ -179,7 +180,8 @@ struct OnSphere {
 #[derive(Args)]
 struct Domain2 {
     /// The orbit space: a flat torus (default), the Klein bottle (--box L1 L2, the glide
-    /// along the first axis), or the sphere (no box; drawn in an equal-area projection)
+    /// along the first axis), the sphere or the projective plane (no box; drawn in an
+    /// equal-area projection, RP² on its covering sphere)
     #[arg(long, value_name = "NAME", default_value = "torus", value_parser = PossibleValuesParser::new(TORUS_AND_KLEIN.into_iter().chain(SPHERES)))]
     space: String,
     #[command(flatten)]
@@ -367,7 +369,7 @@ fn space(domain: &Domain) -> Result<Space, CliError> {
     }
     if domain.on_sphere.lonlat || domain.on_sphere.normalize {
         return Err(CliError::Usage(
-            "--lonlat and --normalize are for --space sphere".into(),
+            "--lonlat and --normalize are for --space sphere and projective-plane".into(),
         ));
     }
     match domain.space.as_str() {

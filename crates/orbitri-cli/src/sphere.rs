@@ -1,11 +1,11 @@
-//! `--space sphere`: the commands on the unit sphere (points as unit vectors or, with
-//! `--lonlat`, longitude and latitude in degrees).
+//! `--space sphere` and `--space projective-plane`: the commands on the unit sphere and on
+//! RP² (points as unit vectors or, with `--lonlat`, longitude and latitude in degrees).
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use orbitri::io::SvgOptions;
-use orbitri::spherical::{lonlat_to_point, normalized, SphericalDelaunay};
+use orbitri::spherical::{lonlat_to_point, normalized, SphericalSpace, SphericalTriangulation};
 
 use super::{
     output_format, progress_bar, rss, write_with, CliError, Domain, Format, Output, VoronoiArgs,
@@ -22,9 +22,10 @@ fn read(input: &Path, domain: &Domain, weighting: &Weighting) -> Result<Vec<[f64
     }
     let e = &domain.extent;
     if e.box_lengths.is_some() || e.lattice.is_some() || e.cellpar.is_some() {
-        return Err(CliError::Usage(
-            "--space sphere has no box: drop --box, --lattice and --cellpar".into(),
-        ));
+        return Err(CliError::Usage(format!(
+            "--space {} has no box: drop --box, --lattice and --cellpar",
+            domain.space
+        )));
     }
     if domain.on_sphere.lonlat {
         let ll = orbitri::io::read_points::<2>(input)?;
@@ -43,10 +44,12 @@ fn read(input: &Path, domain: &Domain, weighting: &Weighting) -> Result<Vec<[f64
 }
 
 /// Builds with a progress bar; the build's seconds and the peak memory after it.
-fn build(pts: &[[f64; 3]]) -> Result<(SphericalDelaunay, super::Cost), CliError> {
+fn build<S: SphericalSpace>(
+    pts: &[[f64; 3]],
+) -> Result<(SphericalTriangulation<S>, super::Cost), CliError> {
     let bar = progress_bar(pts.len(), pts.len(), "triangulation");
     let start = Instant::now();
-    let tri = SphericalDelaunay::build_with(pts, |k| {
+    let tri = SphericalTriangulation::build_with(pts, |k| {
         if let Some(b) = &bar {
             b.set_position(k as u64);
         }
@@ -62,7 +65,11 @@ fn build(pts: &[[f64; 3]]) -> Result<(SphericalDelaunay, super::Cost), CliError>
     Ok((tri, cost))
 }
 
-fn stats_line(tri: &SphericalDelaunay, input: usize, cost: &super::Cost) -> String {
+fn stats_line<S: SphericalSpace>(
+    tri: &SphericalTriangulation<S>,
+    input: usize,
+    cost: &super::Cost,
+) -> String {
     format!(
         "input={input} vertices={} faces={} dimension={} covers_sphere={} duplicates={} hidden={} build_seconds={:.6} peak_rss_kb={}",
         tri.number_of_vertices(),
@@ -76,7 +83,27 @@ fn stats_line(tri: &SphericalDelaunay, input: usize, cost: &super::Cost) -> Stri
     )
 }
 
+/// Runs `$f::<S>(args)` with the space `--space` names.
+macro_rules! on {
+    ($domain:expr, $f:ident($($arg:expr),*)) => {
+        if $domain.space == "projective-plane" {
+            $f::<orbitri::ProjectivePlane>($($arg),*)
+        } else {
+            $f::<orbitri::Sphere>($($arg),*)
+        }
+    };
+}
+
 pub(super) fn triangulate(
+    input: &Path,
+    domain: &Domain,
+    weighting: &Weighting,
+    out: Output,
+) -> Result<(), CliError> {
+    on!(domain, triangulate_in(input, domain, weighting, out))
+}
+
+fn triangulate_in<S: SphericalSpace>(
     input: &Path,
     domain: &Domain,
     weighting: &Weighting,
@@ -89,7 +116,7 @@ pub(super) fn triangulate(
         Format::Cells,
     )?;
     let pts = read(input, domain, weighting)?;
-    let (tri, cost) = build(&pts)?;
+    let (tri, cost) = build::<S>(&pts)?;
     write_with(&out.output, |w| match format {
         Format::Cells => orbitri::io::write_sphere_cells(w, &tri),
         Format::Json => orbitri::io::write_sphere_json(w, &tri),
@@ -102,14 +129,22 @@ pub(super) fn triangulate(
 }
 
 pub(super) fn voronoi(input: &Path, domain: &Domain, args: VoronoiArgs) -> Result<(), CliError> {
+    on!(domain, voronoi_in(input, domain, args))
+}
+
+fn voronoi_in<S: SphericalSpace>(
+    input: &Path,
+    domain: &Domain,
+    args: VoronoiArgs,
+) -> Result<(), CliError> {
     let format = output_format(args.format, &args.output, &[], VoronoiFormat::Csv)?;
     if args.edges.is_some() || args.neighbours.is_some() {
         return Err(CliError::Usage(
-            "--neighbours and --edges are for the flat spaces: on the sphere the JSON cells list each cell's neighbours".into(),
+            "--neighbours and --edges are for the flat spaces: on the sphere and RP² the JSON cells list each cell's neighbours".into(),
         ));
     }
     let pts = read(input, domain, &args.weighting)?;
-    let (tri, cost) = build(&pts)?;
+    let (tri, cost) = build::<S>(&pts)?;
     let start = Instant::now();
     let cells = tri.voronoi_cells()?;
     let seconds = start.elapsed().as_secs_f64();
@@ -124,9 +159,9 @@ pub(super) fn voronoi(input: &Path, domain: &Domain, args: VoronoiArgs) -> Resul
     if args.stats {
         let total: f64 = cells.iter().map(|c| c.area).sum();
         eprintln!(
-            "{} voronoi_seconds={seconds:.6} area_sum={total:?} sphere_area={:?} voronoi_peak_rss_kb={}",
+            "{} voronoi_seconds={seconds:.6} area_sum={total:?} space_area={:?} voronoi_peak_rss_kb={}",
             stats_line(&tri, pts.len(), &cost),
-            4.0 * std::f64::consts::PI,
+            S::AREA,
             rss::peak_kb().map_or("unknown".to_string(), |k| k.to_string())
         );
     }
@@ -140,9 +175,19 @@ pub(super) fn draw(
     output: PathBuf,
     opts: SvgOptions,
 ) -> Result<(), CliError> {
+    on!(domain, draw_in(input, domain, weighting, output, opts))
+}
+
+fn draw_in<S: SphericalSpace>(
+    input: &Path,
+    domain: &Domain,
+    weighting: &Weighting,
+    output: PathBuf,
+    opts: SvgOptions,
+) -> Result<(), CliError> {
     let pts = read(input, domain, weighting)?;
     opts.validate(pts.len()).map_err(super::option_error)?;
-    let (tri, _) = build(&pts)?;
+    let (tri, _) = build::<S>(&pts)?;
     let mut svg = Vec::new();
     orbitri::io::write_sphere_svg(&mut svg, &tri, &opts).map_err(|source| CliError::Write {
         path: output.clone(),

@@ -583,10 +583,10 @@ fn draw_writes_svg_and_png() {
         "-o",
         "x.svg",
     ]);
-    // draw's --box takes 2 lengths: its usage says so
+    // draw's --box takes 2 lengths: the third is refused
     assert_eq!(o.status.code(), Some(2));
     assert!(
-        stderr(&o).contains("unexpected argument '1'") && stderr(&o).contains("--box <LX> <LY>|"),
+        stderr(&o).contains("unexpected argument '1'") && stderr(&o).contains("orbitri draw"),
         "{}",
         stderr(&o)
     );
@@ -1158,7 +1158,7 @@ fn draw_shows_the_klein_bottle_with_its_glide_images() {
     );
     assert_eq!(o.status.code(), Some(2));
     assert!(
-        stderr(&o).contains("[possible values: torus, klein]"),
+        stderr(&o).contains("[possible values: torus, klein, sphere, projective-plane]"),
         "{}",
         stderr(&o)
     );
@@ -1430,4 +1430,50 @@ fn the_sphere_from_the_command_line() {
     assert!(stderr(&o).contains("for --space sphere"), "{}", stderr(&o));
     let o = orbitri(&["triangulate", off.to_str().unwrap()]);
     assert!(stderr(&o).contains("needs its domain"), "{}", stderr(&o));
+}
+
+#[test]
+fn the_projective_plane_from_the_command_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
+    // an octahedron given with both poles and all four equator points: three points of RP²
+    let pts = write(
+        dir.path(),
+        "oct.txt",
+        "1 0 0\n-1 0 0\n0 1 0\n0 -1 0\n0 0 1\n0 0 -1\n",
+    );
+    let rp = |command: &str, extra: &[&str]| {
+        let mut args = vec![
+            command,
+            pts.to_str().unwrap(),
+            "--space",
+            "projective-plane",
+        ];
+        args.extend_from_slice(extra);
+        orbitri(&args)
+    };
+    let o = rp("triangulate", &["--stats", "-o", &path("t.cells")]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("vertices=3 faces=4 dimension=2 covers_sphere=true duplicates=3"));
+    let (header, rows) = cells_file(&std::fs::read_to_string(path("t.cells")).unwrap());
+    assert_eq!(header, vec![1, 3, 4]);
+    // ids of the first occurrences and one sign per vertex, at most one antipode per face
+    for r in &rows {
+        assert_eq!(r.len(), 6);
+        assert!(r[..3].iter().all(|&i| [0, 2, 4].contains(&i)));
+        assert!(r[3..].iter().all(|&s| s == 1 || s == -1));
+        assert!(r[3..].iter().filter(|&&s| s == -1).count() <= 1);
+    }
+    let o = rp("voronoi", &["--stats", "-o", &path("v.csv")]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let line = stderr(&o);
+    let sum: f64 = line
+        .split_whitespace()
+        .find_map(|kv| kv.strip_prefix("area_sum="))
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!((sum - 2.0 * std::f64::consts::PI).abs() < 1e-12, "{line}");
+    let o = rp("draw", &["-o", &path("d.svg")]);
+    assert!(o.status.success(), "{}", stderr(&o));
 }

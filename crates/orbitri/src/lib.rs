@@ -42,9 +42,9 @@ pub use error::{Error, Result};
 pub use ids::{CellId, InputId, PointId, VertexId};
 pub use space::{
     Coset, FlatManifold, FlatSpace, FlatTorus, FlatTorus2, FlatTorus3, Ladder, Lattice, Motion,
-    OrbitSpace, Sphere,
+    OrbitSpace, ProjectivePlane, Sphere,
 };
-pub use spherical::{SphericalCell, SphericalDelaunay};
+pub use spherical::{ProjectiveDelaunay, SphericalCell, SphericalDelaunay};
 pub use triangulation::{
     BuildOptions, CellView, Complex, Copies, DelaunayEdge, KleinTriangulation,
     ManifoldTriangulation3, PeriodicDelaunay, PeriodicDelaunay2, PeriodicDelaunay3, Simplex,

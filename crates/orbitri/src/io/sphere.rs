@@ -7,11 +7,11 @@ use std::io::Write;
 use super::tessellation::{PointTable, Values, Vtu};
 use super::write::{json_f64, json_point};
 use crate::ids::InputId;
-use crate::spherical::{SphericalCell, SphericalDelaunay, Status};
+use crate::spherical::{SphericalCell, SphericalSpace, SphericalTriangulation, Status};
 
 /// Per input: the input id of its first occurrence (itself unless a duplicate), `None`
 /// for a removed one.
-fn first_occurrences(tri: &SphericalDelaunay) -> Vec<Option<InputId>> {
+fn first_occurrences<S: SphericalSpace>(tri: &SphericalTriangulation<S>) -> Vec<Option<InputId>> {
     (0..tri.number_of_input_points())
         .map(|i| {
             let i = InputId::new(i);
@@ -24,22 +24,37 @@ fn first_occurrences(tri: &SphericalDelaunay) -> Vec<Option<InputId>> {
 }
 
 /// The `cells` format on the sphere: `1 V F` (one sheet, `V` vertices, `F` faces), then
-/// per face its three input ids, counter-clockwise seen from outside.
-pub fn write_sphere_cells(w: &mut impl Write, tri: &SphericalDelaunay) -> std::io::Result<()> {
+/// per face its three input ids, counter-clockwise seen from outside. On the projective
+/// plane each line adds the three vertices' signs (`1`, or `-1` for the antipode of the
+/// stored point): the lifted face `(s₀p₀, s₁p₁, s₂p₂)` is counter-clockwise.
+pub fn write_sphere_cells<S: SphericalSpace>(
+    w: &mut impl Write,
+    tri: &SphericalTriangulation<S>,
+) -> std::io::Result<()> {
     let faces = tri.faces();
     writeln!(w, "1 {} {}", tri.number_of_vertices(), faces.len())?;
-    for [a, b, c] in faces {
-        writeln!(w, "{a} {b} {c}")?;
+    let projective = S::AREA < 4.0 * std::f64::consts::PI;
+    for ([a, b, c], s) in faces.into_iter().zip(tri.face_signs()) {
+        if projective {
+            let [x, y, z] = s.map(|n| if n { -1 } else { 1 });
+            writeln!(w, "{a} {b} {c} {x} {y} {z}")?;
+        } else {
+            writeln!(w, "{a} {b} {c}")?;
+        }
     }
     Ok(())
 }
 
-/// JSON: `{"space": "sphere", "dimension"` (CGAL's, −2 to 2), `"covers_sphere"`,
-/// `"points"` (input order, `null` for removed ones), `"first_occurrence"` (`-1` for
-/// removed), `"hidden"`, `"faces"` (input ids, counter-clockwise from outside) and
+/// JSON: `{"space": "sphere"` (or `"projective-plane"`), `"dimension"` (CGAL's, −2 to 2),
+/// `"covers_sphere"`, `"points"` (input order as stored, `null` for removed ones),
+/// `"first_occurrence"` (`-1` for removed), `"hidden"`, `"faces"` (input ids,
+/// counter-clockwise from outside), `"signs"` (per face vertex, `-1` for an antipode) and
 /// `"neighbors"` (per face, the face across each edge `k` opposite vertex `k`, `-1` where
 /// the points leave a hemisphere open)`}`.
-pub fn write_sphere_json(w: &mut impl Write, tri: &SphericalDelaunay) -> std::io::Result<()> {
+pub fn write_sphere_json<S: SphericalSpace>(
+    w: &mut impl Write,
+    tri: &SphericalTriangulation<S>,
+) -> std::io::Result<()> {
     let n = tri.number_of_input_points();
     let points: Vec<String> = (0..n)
         .map(|i| {
@@ -67,15 +82,22 @@ pub fn write_sphere_json(w: &mut impl Write, tri: &SphericalDelaunay) -> std::io
             format!("[{}]", s.join(","))
         })
         .collect();
+    let signs: Vec<String> = tri
+        .face_signs()
+        .iter()
+        .map(|s| format!("[{}]", s.map(|n| if n { "-1" } else { "1" }).join(",")))
+        .collect();
     writeln!(
         w,
-        "{{\"space\":\"sphere\",\"dimension\":{},\"covers_sphere\":{},\"points\":[{}],\"first_occurrence\":[{}],\"hidden\":{},\"faces\":[{}],\"neighbors\":[{}]}}",
+        "{{\"space\":\"{}\",\"dimension\":{},\"covers_sphere\":{},\"points\":[{}],\"first_occurrence\":[{}],\"hidden\":{},\"faces\":[{}],\"signs\":[{}],\"neighbors\":[{}]}}",
+        S::NAME,
         tri.dimension(),
         tri.covers_sphere(),
         points.join(","),
         firsts.join(","),
         ids(&tri.hidden()),
         faces.join(","),
+        signs.join(","),
         neighbors.join(",")
     )
 }
@@ -83,7 +105,10 @@ pub fn write_sphere_json(w: &mut impl Write, tri: &SphericalDelaunay) -> std::io
 /// The per-point table on the sphere, one row per input in input order (removed ones
 /// left out): `id, area, neighbours, perimeter, centroid_x, centroid_y, centroid_z, hidden,
 /// duplicate_of` (a hidden point's cell is empty: area 0, no centroid).
-pub fn sphere_point_table(tri: &SphericalDelaunay, cells: &[SphericalCell]) -> PointTable {
+pub fn sphere_point_table<S: SphericalSpace>(
+    tri: &SphericalTriangulation<S>,
+    cells: &[SphericalCell],
+) -> PointTable {
     let mut by_site = vec![None; tri.number_of_input_points()];
     for c in cells {
         by_site[c.site.index()] = Some(c);
@@ -130,12 +155,12 @@ pub fn sphere_point_table(tri: &SphericalDelaunay, cells: &[SphericalCell]) -> P
 /// Every Voronoi cell as JSON: `{"space": "sphere", "cells": [{"id", "position", "area",
 /// "centroid", "vertices"` (counter-clockwise from outside), `"neighbors"` (across the arc
 /// from vertex `k` to `k + 1`), `"arc_lengths"}…], "duplicate_of"}`.
-pub fn write_spherical_voronoi_json(
+pub fn write_spherical_voronoi_json<S: SphericalSpace>(
     w: &mut impl Write,
-    tri: &SphericalDelaunay,
+    tri: &SphericalTriangulation<S>,
     cells: &[SphericalCell],
 ) -> std::io::Result<()> {
-    write!(w, "{{\"space\":\"sphere\",\"cells\":[")?;
+    write!(w, "{{\"space\":\"{}\",\"cells\":[", S::NAME)?;
     for (k, c) in cells.iter().enumerate() {
         let vertices: Vec<String> = c.vertices.iter().map(|v| json_point(v)).collect();
         let neighbors: Vec<String> = c.neighbors.iter().map(|x| x.to_string()).collect();
@@ -212,19 +237,25 @@ pub fn write_spherical_voronoi_vtu(
 }
 
 /// The faces as a binary `.vtu` of triangles on the vertices (flat triangles with their
-/// corners on the sphere), with the input id of each vertex as point data.
-pub fn write_sphere_faces_vtu(w: &mut impl Write, tri: &SphericalDelaunay) -> std::io::Result<()> {
+/// corners on the sphere; on RP², each face lifted by its signs), with the input id of each
+/// vertex as point data.
+pub fn write_sphere_faces_vtu<S: SphericalSpace>(
+    w: &mut impl Write,
+    tri: &SphericalTriangulation<S>,
+) -> std::io::Result<()> {
     let mut v = Vtu::default();
-    let mut index = vec![-1i64; tri.number_of_input_points()];
+    // one point per (input, sign): a face of RP² may use a point's antipode
+    let mut index: std::collections::HashMap<(InputId, bool), i64> = Default::default();
     let mut pid = Vec::new();
-    for f in tri.faces() {
-        for i in f {
-            if index[i.index()] < 0 {
-                index[i.index()] = v.points.len() as i64;
-                v.points.push(tri.point(i).expect("a vertex is live"));
+    for (f, signs) in tri.faces().into_iter().zip(tri.face_signs()) {
+        for (i, s) in f.into_iter().zip(signs) {
+            let id = *index.entry((i, s)).or_insert_with(|| {
+                let p = tri.point(i).expect("a vertex is live");
+                v.points.push(if s { p.map(|x| -x) } else { p });
                 pid.push(i64::from(i.0));
-            }
-            v.connectivity.push(index[i.index()]);
+                v.points.len() as i64 - 1
+            });
+            v.connectivity.push(id);
         }
         v.offsets.push(v.connectivity.len() as i64);
         v.types.push(5); // VTK_TRIANGLE
@@ -275,10 +306,11 @@ fn arcs_path(
 
 /// The triangulation (blue edges) and Voronoi diagram (red arcs) on the sphere as SVG, in
 /// the Hammer equal-area projection of the whole sphere (an ellipse twice as wide as
-/// high, longitude 0 in the middle); `opts.copies` does not apply.
-pub fn write_sphere_svg(
+/// high, longitude 0 in the middle); `opts.copies` does not apply. The projective plane is
+/// drawn on its covering sphere: every face and cell with its antipode.
+pub fn write_sphere_svg<S: SphericalSpace>(
     w: &mut impl Write,
-    tri: &SphericalDelaunay,
+    tri: &SphericalTriangulation<S>,
     opts: &super::SvgOptions,
 ) -> std::io::Result<()> {
     let (width, height) = (opts.width, opts.width / 2.0);
@@ -287,6 +319,12 @@ pub fn write_sphere_svg(
     let px = |q: [f64; 2]| (width / 2.0 + q[0] * scale, height / 2.0 - q[1] * scale);
     let n = tri.number_of_vertices().max(1) as f64;
     let stroke = (width / n.sqrt() / 25.0).clamp(0.15, 1.5);
+    // the copies drawn: the point itself, and on RP² its antipode
+    let copies: &[f64] = if S::AREA < 4.0 * std::f64::consts::PI {
+        &[1.0, -1.0]
+    } else {
+        &[1.0]
+    };
     writeln!(
         w,
         r#"<svg xmlns="http://www.w3.org/2000/svg" width="{width:.0}" height="{height:.0}" viewBox="0 0 {width:.2} {height:.2}">"#
@@ -303,14 +341,19 @@ pub fn write_sphere_svg(
     )?;
     writeln!(w, r#"<g fill="none">"#)?;
     let point = |i: InputId| tri.point(i).expect("a vertex is live");
+    let times = |p: [f64; 3], k: f64| p.map(|x| x * k);
     if opts.voronoi {
         if let Ok(cells) = tri.voronoi_cells() {
             let arcs = cells.iter().flat_map(|c| {
                 let m = c.vertices.len();
                 // each arc once: from the cell of the smaller site
                 (0..m)
-                    .filter(move |&k| c.site < c.neighbors[k])
-                    .map(move |k| (c.vertices[k], c.vertices[(k + 1) % m]))
+                    .filter(move |&k| c.site <= c.neighbors[k])
+                    .flat_map(move |k| {
+                        copies.iter().map(move |&s| {
+                            (times(c.vertices[k], s), times(c.vertices[(k + 1) % m], s))
+                        })
+                    })
             });
             writeln!(
                 w,
@@ -320,19 +363,31 @@ pub fn write_sphere_svg(
         }
     }
     if opts.delaunay {
-        // each edge once (an edge of a hemisphere's rim has one face)
-        let mut all: Vec<(InputId, InputId)> = tri
-            .faces()
-            .iter()
-            .flat_map(|f| (0..3).map(move |k| (f[k].min(f[(k + 1) % 3]), f[k].max(f[(k + 1) % 3]))))
-            .collect();
+        // each edge once (an edge of a hemisphere's rim has one face), by its lifted ends
+        let mut all: Vec<[[u64; 3]; 2]> = Vec::new();
+        for (f, signs) in tri.faces().iter().zip(tri.face_signs()) {
+            let q = std::array::from_fn::<_, 3, _>(|k| {
+                times(point(f[k]), if signs[k] { -1.0 } else { 1.0 })
+            });
+            for k in 0..3 {
+                for &s in copies {
+                    let mut e =
+                        [times(q[k], s), times(q[(k + 1) % 3], s)].map(|p| p.map(f64::to_bits));
+                    e.sort_unstable();
+                    all.push(e);
+                }
+            }
+        }
         all.sort_unstable();
         all.dedup();
+        let arcs = all
+            .into_iter()
+            .map(|e| (e[0].map(f64::from_bits), e[1].map(f64::from_bits)));
         writeln!(
             w,
             r##"<path id="delaunay" stroke="#2a6f97" stroke-width="{:.2}" d="{}"/>"##,
             stroke * 0.8,
-            arcs_path(all.into_iter().map(|(a, b)| (point(a), point(b))), px)
+            arcs_path(arcs, px)
         )?;
     }
     writeln!(w, "</g>")?;
@@ -340,8 +395,10 @@ pub fn write_sphere_svg(
         let r = (stroke * 2.0).max(0.8);
         writeln!(w, r##"<g id="points" fill="#111">"##)?;
         for i in tri.vertices() {
-            let (x, y) = px(hammer(&point(i)).0);
-            writeln!(w, r#"<circle cx="{x:.2}" cy="{y:.2}" r="{r:.2}"/>"#)?;
+            for &s in copies {
+                let (x, y) = px(hammer(&times(point(i), s)).0);
+                writeln!(w, r#"<circle cx="{x:.2}" cy="{y:.2}" r="{r:.2}"/>"#)?;
+            }
         }
         writeln!(w, "</g>")?;
     }

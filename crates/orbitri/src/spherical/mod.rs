@@ -136,6 +136,8 @@ pub trait SphericalSpace:
     fn is_antipode(g: Self::Elem) -> bool;
     /// The area of the space: 4π, 2π.
     const AREA: f64;
+    /// The space's name in outputs (`--space` of the command).
+    const NAME: &'static str;
 }
 
 impl SphericalSpace for Sphere {
@@ -155,6 +157,7 @@ impl SphericalSpace for Sphere {
         false
     }
     const AREA: f64 = 4.0 * std::f64::consts::PI;
+    const NAME: &'static str = "sphere";
 }
 
 impl SphericalSpace for ProjectivePlane {
@@ -178,6 +181,7 @@ impl SphericalSpace for ProjectivePlane {
         g.0
     }
     const AREA: f64 = 2.0 * std::f64::consts::PI;
+    const NAME: &'static str = "projective-plane";
 }
 
 /// The Delaunay triangulation of points on the unit sphere.
