@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
-# The sphere (issue "The sphere and the real projective plane"), side by side in one run,
-# per N and repetition, on the CGAL anchor's sphere points (`gens N 1`): `orbitri
-# triangulate --space sphere` against CGAL's `Delaunay_triangulation_on_sphere_2` (`sphere`)
-# and scipy's `ConvexHull` (Qhull), and `orbitri voronoi --space sphere` (build and cells)
-# against scipy's `SphericalVoronoi` (with its areas). Raw lines go to
+# The sphere and the projective plane (issue "The sphere and the real projective plane"),
+# side by side in one run, per N and repetition, on the CGAL anchor's sphere points
+# (`gens N 1`): `orbitri triangulate --space sphere` against CGAL's
+# `Delaunay_triangulation_on_sphere_2` (`sphere`) and scipy's `ConvexHull` (Qhull), `orbitri
+# triangulate --space projective-plane` on the same points (case rp2), and `orbitri voronoi
+# --space sphere` (build and cells) against scipy's `SphericalVoronoi` (with its areas).
+# scipy runs once per N (it takes 20–60 s at 10⁶). Raw lines go to
 # bench/out/sphere_raw.txt, medians are printed as table rows.
 #
 # usage: bench/sphere.sh [REPS] [N ...]      default: 5 reps, N = 100000 1000000
@@ -31,6 +33,11 @@ for n in $ns; do
         line=$("$orb" triangulate "$pts" --space sphere --stats --format cells -o /dev/null 2>&1)
         echo "tool=orbitri case=delaunay N=$n rep=$rep $line $stamp"
         echo "tool=cgal case=delaunay N=$n rep=$rep $("$cgal" sphere "$n" 1) $stamp"
+        line=$("$orb" triangulate "$pts" --space projective-plane --stats --format cells -o /dev/null 2>&1)
+        echo "tool=orbitri case=rp2 N=$n rep=$rep $line $stamp"
+        line=$("$orb" voronoi "$pts" --space sphere --stats --format csv -o /dev/null 2>&1)
+        echo "tool=orbitri case=voronoi N=$n rep=$rep $line $stamp"
+        [ "$rep" = 1 ] || continue
         for mode in hull voronoi; do
             line=$("$venv/bin/python" - "$pts" "$mode" <<'PY'
 import resource, sys, time
@@ -53,8 +60,6 @@ PY
             case=$([ "$mode" = hull ] && echo delaunay || echo voronoi)
             echo "tool=scipy case=$case N=$n rep=$rep $line $stamp"
         done
-        line=$("$orb" voronoi "$pts" --space sphere --stats --format csv -o /dev/null 2>&1)
-        echo "tool=orbitri case=voronoi N=$n rep=$rep $line $stamp"
     done
 done | tee -a "$raw"
 python3 "$root/bench/medians.py" "$raw" "$(git -C "$root" rev-parse --short HEAD)" --voronoi voronoi

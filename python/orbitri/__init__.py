@@ -2,7 +2,8 @@
 
 The domain is a flat torus, a periodic box of any lattice (``PeriodicDelaunay``), a
 closed flat manifold: the Klein bottle or a flat 3-manifold (``Triangulation`` with a
-``KleinBottle`` or ``FlatManifold`` space), or the sphere (``SphericalDelaunay``). Every geometric decision is exact, and
+``KleinBottle`` or ``FlatManifold`` space), the sphere (``SphericalDelaunay``) or the real
+projective plane (``ProjectivePlane``). Every geometric decision is exact, and
 degenerate inputs (crystals, grids, duplicates) are handled, not rejected.
 
 >>> import numpy as np, orbitri
@@ -30,7 +31,7 @@ from ._orbitri import Triangulation as _Triangulation
 from ._orbitri import __version__
 from ._orbitri import cellpar_matrix as _cellpar_matrix
 from ._orbitri import set_progress_hook as _set_progress_hook
-from ._sphere import SphericalDelaunay, SphericalVoronoi
+from ._sphere import ProjectivePlane, SphericalDelaunay, SphericalVoronoi
 
 __all__ = [
     "Box",
@@ -38,6 +39,7 @@ __all__ = [
     "KleinBottle",
     "NeighborList",
     "PeriodicDelaunay",
+    "ProjectivePlane",
     "SphericalDelaunay",
     "SphericalVoronoi",
     "Triangulation",

@@ -1,4 +1,5 @@
-"""The sphere: ``SphericalDelaunay`` and its ``SphericalVoronoi`` cells."""
+"""The sphere and the projective plane: ``SphericalDelaunay``, ``ProjectivePlane`` and
+their ``SphericalVoronoi`` cells."""
 
 from __future__ import annotations
 
@@ -40,16 +41,20 @@ class SphericalDelaunay:
     (38, 22)
     """
 
+    _projective = False
+
     def __init__(self, points=None, lonlat=None, normalize: bool = False):
         if (points is None) == (lonlat is None):
             raise TypeError("give either points (N × 3) or lonlat (N × 2)")
         if lonlat is not None:
-            self._tri = _SphericalTriangulation(np.asarray(lonlat, dtype=float), lonlat=True)
+            self._tri = _SphericalTriangulation(
+                np.asarray(lonlat, dtype=float), lonlat=True, projective=self._projective
+            )
         else:
             p = np.asarray(points, dtype=float)
             if normalize:
                 p = self._normalized(p)
-            self._tri = _SphericalTriangulation(p)
+            self._tri = _SphericalTriangulation(p, projective=self._projective)
         self._faces = None
 
     @staticmethod
@@ -72,7 +77,7 @@ class SphericalDelaunay:
 
     def __repr__(self) -> str:
         return (
-            f"<orbitri.SphericalDelaunay: {self.number_of_vertices} vertices, "
+            f"<orbitri.{type(self).__name__}: {self.number_of_vertices} vertices, "
             f"{len(self.simplices)} faces, dimension {self.dimension}>"
         )
 
@@ -89,8 +94,18 @@ class SphericalDelaunay:
         return self._arrays()[1]
 
     @property
+    def signs(self) -> np.ndarray:
+        """Each face vertex's sign (F × 3): −1 where the face uses the antipode of the
+        stored point (only on the projective plane, at most one per face), so that
+        ``signs[..., None] * points[simplices]`` is the face counter-clockwise from
+        outside."""
+        return self._arrays()[2]
+
+    @property
     def points(self) -> np.ndarray:
-        """The points as stored (N × 3, input order; NaN rows for removed ones)."""
+        """The points as stored (N × 3, input order; NaN rows for removed ones; on the
+        projective plane the representative of ``±p`` whose last non-zero coordinate, in
+        the order z, y, x, is positive)."""
         return self._tri.points
 
     @property
@@ -165,9 +180,33 @@ class SphericalDelaunay:
         return SphericalVoronoi(self._tri.voronoi(), self)
 
 
+class ProjectivePlane(SphericalDelaunay):
+    """The exact Delaunay triangulation of the real projective plane RP² = S²/{±1}: the
+    triangulation of the points and their antipodes on the sphere, each pair one point. It
+    is computed in the 2-sheeted covering sphere until Caroli's criterion (every empty
+    circle of angular diameter below π/2) lets it switch to RP² itself.
+
+    Points and options as for ``SphericalDelaunay``; ``p`` and ``-p`` are one point (the
+    second a duplicate). Faces are ``simplices`` with ``signs``: the face's vertices are
+    ``signs * points[simplices]`` (RP² is not orientable: a face is oriented in its own
+    frame). The Voronoi cells are those around each stored representative; their areas sum
+    to 2π.
+
+    >>> import numpy as np, orbitri
+    >>> p = np.random.default_rng(3).normal(size=(500, 3))
+    >>> rp2 = orbitri.ProjectivePlane(p / np.linalg.norm(p, axis=1)[:, None])
+    >>> len(rp2.simplices), rp2.dimension      # Euler characteristic 1: F = 2V − 2
+    (998, 2)
+    >>> bool(abs(rp2.voronoi().areas.sum() - 2 * np.pi) < 1e-12)
+    True
+    """
+
+    _projective = True
+
+
 class SphericalVoronoi:
-    """The Voronoi cells on the sphere, per input point in input order: ``areas``
-    (steradians, summing to 4π), ``neighbor_counts``, ``perimeters`` (radians) and
+    """The Voronoi cells on the sphere (or RP²), per input point in input order: ``areas``
+    (steradians, summing to 4π; 2π on RP²), ``neighbor_counts``, ``perimeters`` (radians) and
     ``centroids`` (unit vectors); a duplicate shares its first occurrence's cell, a hidden
     point's is empty. ``vertices`` and ``regions`` are in the shape of
     ``scipy.spatial.SphericalVoronoi`` (regions counter-clockwise seen from outside);

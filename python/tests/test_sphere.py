@@ -121,3 +121,43 @@ def test_bad_input_is_a_clear_error():
     with pytest.raises(ValueError):
         tri.insert([[0, 0, 1.0], [0, 0, 3.0]])
     assert tri.number_of_input_points == 3
+
+
+def test_projective_plane_is_the_hull_of_both_copies():
+    spatial = pytest.importorskip("scipy.spatial")
+    pts = unit(1500, 11)
+    rp2 = orbitri.ProjectivePlane(pts)
+    assert rp2.is_valid()
+    assert len(rp2.simplices) == 2 * 1500 - 2
+    # each face lifted by its signs is a face of the hull of ±P, counter-clockwise
+    both = np.vstack([pts, -pts])
+    stored = rp2.points
+    faces = rp2.signs[..., None] * stored[rp2.simplices]
+    assert (np.einsum("ij,ij->i", faces[:, 0], np.cross(faces[:, 1], faces[:, 2])) > 0).all()
+    hull = spatial.ConvexHull(both)
+
+    def key(tri):
+        # a face and its antipode as one set of rounded coordinates
+        a = tuple(sorted(tuple(np.round(v, 12)) for v in tri))
+        b = tuple(sorted(tuple(np.round(-v, 12)) for v in tri))
+        return min(a, b)
+
+    ours = {key(f) for f in faces}
+    theirs = {key(both[s]) for s in hull.simplices}
+    assert ours == theirs
+    # a cell of RP² is that of its point in the sphere's diagram of ±P
+    vor = rp2.voronoi()
+    sv = spatial.SphericalVoronoi(both).calculate_areas()
+    np.testing.assert_allclose(vor.areas, sv[:1500], rtol=0, atol=1e-9)
+    assert abs(vor.areas.sum() - 2 * np.pi) < 1e-12
+
+
+def test_projective_plane_small_sets_and_antipodes():
+    rp2 = orbitri.ProjectivePlane([[0.0, 0, 1], [0, 0, -1]])
+    assert rp2.dimension == -1
+    assert rp2.duplicates.tolist() == [0, 0]
+    rp2.insert([[1.0, 0, 0], [0, 1.0, 0]])
+    assert rp2.dimension == 2 and len(rp2.simplices) == 4
+    assert (np.abs(rp2.signs) == 1).all()
+    assert rp2.voronoi().areas[[0, 2, 3]].sum() == pytest.approx(2 * np.pi, abs=1e-12)
+    assert "ProjectivePlane" in repr(rp2)

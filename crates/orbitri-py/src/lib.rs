@@ -1298,7 +1298,7 @@ fn _orbitri(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Triangulation>()?;
     m.add_class::<Voronoi>()?;
     m.add_class::<Space>()?;
-    m.add_class::<sphere::SphericalTriangulation>()?;
+    m.add_class::<sphere::PySpherical>()?;
     m.add_class::<sphere::SphericalVoronoi>()?;
     m.add("PLATYCOSMS", FlatManifold::PLATYCOSMS.to_vec())?;
     Ok(())

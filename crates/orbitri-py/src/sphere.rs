@@ -1,6 +1,7 @@
-//! The sphere for Python: `orbitri._orbitri.SphericalTriangulation` (use
-//! `orbitri.SphericalDelaunay`) and its Voronoi cells, with the same threading and Ctrl-C
-//! rules as the flat spaces' class (`interruptible`, a read–write lock).
+//! The sphere and the projective plane for Python: `orbitri._orbitri.SphericalTriangulation`
+//! (use `orbitri.SphericalDelaunay` or `orbitri.ProjectivePlane`) and its Voronoi cells,
+//! with the same threading and Ctrl-C rules as the flat spaces' class (`interruptible`, a
+//! read–write lock).
 
 use std::collections::HashMap;
 use std::ops::ControlFlow;
@@ -9,7 +10,10 @@ use std::sync::{Arc, RwLock, RwLockReadGuard, RwLockWriteGuard};
 
 use numpy::ndarray::Array1;
 use numpy::{AllowTypeChange, IntoPyArray, PyArray1, PyArray2, PyArrayLike2};
-use orbitri::spherical::{lonlat_to_point, SphericalDelaunay, Status};
+use orbitri::spherical::{
+    lonlat_to_point, ProjectiveDelaunay, SphericalDelaunay, SphericalSpace, SphericalTriangulation,
+    Status,
+};
 use orbitri::{InputId, SphericalCell};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -48,27 +52,69 @@ fn unit_vectors(
         .collect()
 }
 
-/// The Delaunay triangulation of points on the unit sphere (use `orbitri.SphericalDelaunay`),
-/// shareable between threads.
-#[pyclass(module = "orbitri._orbitri", frozen)]
-pub(super) struct SphericalTriangulation {
-    tri: Arc<RwLock<SphericalDelaunay>>,
+/// The triangulation of either space.
+enum Spherical {
+    Sphere(SphericalDelaunay),
+    Projective(ProjectiveDelaunay),
+}
+
+/// Runs `$body` with `$t` bound to the triangulation of either space.
+macro_rules! with_s {
+    ($tri:expr, $t:ident => $body:expr) => {
+        match $tri {
+            Spherical::Sphere($t) => $body,
+            Spherical::Projective($t) => $body,
+        }
+    };
+}
+
+/// Builds in space `S`, answering Ctrl-C and showing progress.
+fn build<S: SphericalSpace>(
+    py: Python<'_>,
+    pts: Vec<[f64; 3]>,
+) -> PyResult<SphericalTriangulation<S>>
+where
+    SphericalTriangulation<S>: Send,
+{
+    let total = pts.len() as u64;
+    interruptible(py, pts.len(), ("triangulating", total), move |control| {
+        SphericalTriangulation::<S>::build_with(&pts, |k| {
+            control.done.store(k as u64, Ordering::Relaxed);
+            if control.stopped() {
+                ControlFlow::Break(())
+            } else {
+                ControlFlow::Continue(())
+            }
+        })
+        .map_err(value_error)
+    })
+}
+
+/// The Delaunay triangulation of points on the unit sphere or of the projective plane
+/// (use `orbitri.SphericalDelaunay`, `orbitri.ProjectivePlane`), shareable between threads.
+#[pyclass(module = "orbitri._orbitri", frozen, name = "SphericalTriangulation")]
+pub(super) struct PySpherical {
+    tri: Arc<RwLock<Spherical>>,
     /// Counts the modifications (for the Python side's cache of the faces).
     generation: AtomicU64,
 }
 
-impl SphericalTriangulation {
-    fn read(&self, py: Python<'_>) -> PyResult<RwLockReadGuard<'_, SphericalDelaunay>> {
+impl PySpherical {
+    fn read(&self, py: Python<'_>) -> PyResult<RwLockReadGuard<'_, Spherical>> {
         self.tri.read_py_attached(py).map_err(poisoned)
     }
 
-    fn write(&self, py: Python<'_>) -> PyResult<RwLockWriteGuard<'_, SphericalDelaunay>> {
+    fn write(&self, py: Python<'_>) -> PyResult<RwLockWriteGuard<'_, Spherical>> {
         self.tri.write_py_attached(py).map_err(poisoned)
     }
 }
 
-/// Two integer arrays (faces and their neighbours).
-type IntPair<'py> = (Bound<'py, PyArray2<i64>>, Bound<'py, PyArray2<i64>>);
+/// Faces, their neighbours and their vertices' signs.
+type Faces<'py> = (
+    Bound<'py, PyArray2<i64>>,
+    Bound<'py, PyArray2<i64>>,
+    Bound<'py, PyArray2<i64>>,
+);
 /// Areas, neighbour counts, perimeters and centroids.
 type Measures<'py> = (
     Bound<'py, PyArray1<f64>>,
@@ -79,36 +125,43 @@ type Measures<'py> = (
 /// scipy's vertices and regions.
 type Regions<'py> = (Bound<'py, PyArray2<f64>>, Vec<Bound<'py, PyArray1<i64>>>);
 
+/// Per input, its first occurrence (`None` once removed).
+fn first_occurrences<S: SphericalSpace>(t: &SphericalTriangulation<S>) -> Vec<Option<InputId>> {
+    (0..t.number_of_input_points())
+        .map(|i| {
+            let i = InputId::new(i);
+            t.status(i).map(|s| match s {
+                Status::Duplicate(j) => j,
+                _ => i,
+            })
+        })
+        .collect()
+}
+
 /// `None` → −1, for index arrays.
 fn or_minus_one(x: Option<usize>) -> i64 {
     x.map_or(-1, |k| k as i64)
 }
 
 #[pymethods]
-impl SphericalTriangulation {
+impl PySpherical {
     /// Triangulates `points`: unit vectors `(N, 3)` or, with `lonlat`, longitudes and
-    /// latitudes in degrees `(N, 2)`.
+    /// latitudes in degrees `(N, 2)`; on the projective plane with `projective`.
     #[new]
-    #[pyo3(signature = (points, lonlat = false))]
+    #[pyo3(signature = (points, lonlat = false, projective = false))]
     fn new(
         py: Python<'_>,
         points: PyArrayLike2<'_, f64, AllowTypeChange>,
         lonlat: bool,
+        projective: bool,
     ) -> PyResult<Self> {
         let pts = unit_vectors(&points, lonlat)?;
-        let total = pts.len() as u64;
-        let tri = interruptible(py, pts.len(), ("triangulating", total), move |control| {
-            SphericalDelaunay::build_with(&pts, |k| {
-                control.done.store(k as u64, Ordering::Relaxed);
-                if control.stopped() {
-                    ControlFlow::Break(())
-                } else {
-                    ControlFlow::Continue(())
-                }
-            })
-            .map_err(value_error)
-        })?;
-        Ok(SphericalTriangulation {
+        let tri = if projective {
+            Spherical::Projective(build(py, pts)?)
+        } else {
+            Spherical::Sphere(build(py, pts)?)
+        };
+        Ok(PySpherical {
             tri: Arc::new(RwLock::new(tri)),
             generation: AtomicU64::new(0),
         })
@@ -123,32 +176,31 @@ impl SphericalTriangulation {
     /// The points as stored (N × 3, input order; NaN rows for removed inputs).
     #[getter]
     fn points<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let t = self.read(py)?;
-        let n = t.number_of_input_points();
-        let v: Vec<f64> = (0..n)
-            .flat_map(|i| t.point(InputId::new(i)).unwrap_or([f64::NAN; 3]))
-            .collect();
-        Ok(array2(py, n, 3, v))
+        with_s!(&*self.read(py)?, t => {
+            let n = t.number_of_input_points();
+            let v: Vec<f64> = (0..n)
+                .flat_map(|i| t.point(InputId::new(i)).unwrap_or([f64::NAN; 3]))
+                .collect();
+            Ok(array2(py, n, 3, v))
+        })
     }
 
     /// CGAL's dimension: −2 (empty) to 2.
     #[getter]
     fn dimension(&self, py: Python<'_>) -> PyResult<i32> {
-        Ok(self.read(py)?.dimension())
+        Ok(with_s!(&*self.read(py)?, t => t.dimension()))
     }
 
     /// True when the points enclose the centre (the faces cover the sphere).
     #[getter]
     fn covers_sphere(&self, py: Python<'_>) -> PyResult<bool> {
-        Ok(self.read(py)?.covers_sphere())
+        Ok(with_s!(&*self.read(py)?, t => t.covers_sphere()))
     }
 
     /// The hidden input ids, sorted.
     #[getter]
     fn hidden<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<i64>>> {
-        let h: Vec<i64> = self
-            .read(py)?
-            .hidden()
+        let h: Vec<i64> = with_s!(&*self.read(py)?, t => t.hidden())
             .iter()
             .map(|i| i64::from(i.0))
             .collect();
@@ -159,16 +211,10 @@ impl SphericalTriangulation {
     /// removed).
     #[getter]
     fn duplicates<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<i64>>> {
-        let t = self.read(py)?;
-        Ok((0..t.number_of_input_points())
-            .map(|i| {
-                let i = InputId::new(i);
-                match t.status(i) {
-                    None => -1,
-                    Some(Status::Duplicate(j)) => i64::from(j.0),
-                    Some(_) => i64::from(i.0),
-                }
-            })
+        let first = with_s!(&*self.read(py)?, t => first_occurrences(t));
+        Ok(first
+            .into_iter()
+            .map(|f| f.map_or(-1, |j| i64::from(j.0)))
             .collect::<Array1<i64>>()
             .into_pyarray(py))
     }
@@ -176,23 +222,32 @@ impl SphericalTriangulation {
     /// Number of distinct, visible points.
     #[getter]
     fn number_of_vertices(&self, py: Python<'_>) -> PyResult<usize> {
-        Ok(self.read(py)?.number_of_vertices())
+        Ok(with_s!(&*self.read(py)?, t => t.number_of_vertices()))
     }
 
-    /// `(faces F × 3, neighbours F × 3)`: input ids counter-clockwise seen from outside, and
-    /// the face across the edge opposite each vertex (−1 where the points leave a hemisphere
-    /// open).
-    fn faces<'py>(&self, py: Python<'py>) -> PyResult<IntPair<'py>> {
-        let t = self.read(py)?;
-        let faces = t.faces();
+    /// `(faces F × 3, neighbours F × 3, signs F × 3)`: input ids counter-clockwise seen from
+    /// outside, the face across the edge opposite each vertex (−1 where the points leave a
+    /// hemisphere open), and each vertex's sign (−1: the antipode of its point, in RP²).
+    fn faces<'py>(&self, py: Python<'py>) -> PyResult<Faces<'py>> {
+        let (faces, neighbors, signs) =
+            with_s!(&*self.read(py)?, t => (t.faces(), t.neighbors(), t.face_signs()));
         let f: Vec<i64> = faces.iter().flatten().map(|i| i64::from(i.0)).collect();
-        let n: Vec<i64> = t
-            .neighbors()
+        let n: Vec<i64> = neighbors
             .iter()
             .flatten()
             .map(|&k| or_minus_one(k))
             .collect();
-        Ok((array2(py, faces.len(), 3, f), array2(py, faces.len(), 3, n)))
+        let s: Vec<i64> = signs
+            .iter()
+            .flatten()
+            .map(|&x| if x { -1 } else { 1 })
+            .collect();
+        let k = faces.len();
+        Ok((
+            array2(py, k, 3, f),
+            array2(py, k, 3, n),
+            array2(py, k, 3, s),
+        ))
     }
 
     /// Inserts `points` (rows, or lon/lat with `lonlat`), all or nothing; per point the
@@ -207,8 +262,10 @@ impl SphericalTriangulation {
         let pts = unit_vectors(&points, lonlat)?;
         let mut guard = self.write(py)?;
         let tri = &mut *guard;
-        let first = tri.number_of_input_points();
-        let status = py.detach(|| tri.insert_all(&pts)).map_err(value_error)?;
+        let first = with_s!(&*tri, t => t.number_of_input_points());
+        let status = py
+            .detach(|| with_s!(tri, t => t.insert_all(&pts)))
+            .map_err(value_error)?;
         self.generation.fetch_add(1, Ordering::AcqRel);
         Ok(status
             .iter()
@@ -227,7 +284,8 @@ impl SphericalTriangulation {
         let ids = input_ids(py, ids)?;
         let mut guard = self.write(py)?;
         let tri = &mut *guard;
-        py.detach(|| tri.remove_all(&ids)).map_err(id_error)?;
+        py.detach(|| with_s!(tri, t => t.remove_all(&ids)))
+            .map_err(id_error)?;
         self.generation.fetch_add(1, Ordering::AcqRel);
         Ok(())
     }
@@ -235,7 +293,7 @@ impl SphericalTriangulation {
     /// The face (input ids) whose cone from the centre holds the direction `point`, or None
     /// outside the faces.
     fn locate(&self, py: Python<'_>, point: [f64; 3]) -> PyResult<Option<[i64; 3]>> {
-        let f = self.read(py)?.locate(point).map_err(value_error)?;
+        let f = with_s!(&*self.read(py)?, t => t.locate(point)).map_err(value_error)?;
         Ok(f.map(|f| f.map(|i| i64::from(i.0))))
     }
 
@@ -249,7 +307,7 @@ impl SphericalTriangulation {
         let [i] = i[..] else {
             return Err(PyValueError::new_err("one input id"));
         };
-        let nb = self.read(py)?.vertex_neighbors(i).map_err(id_error)?;
+        let nb = with_s!(&*self.read(py)?, t => t.vertex_neighbors(i)).map_err(id_error)?;
         Ok(nb
             .iter()
             .map(|x| i64::from(x.0))
@@ -261,7 +319,7 @@ impl SphericalTriangulation {
     fn is_valid(&self, py: Python<'_>) -> PyResult<bool> {
         let guard = self.read(py)?;
         let tri = &*guard;
-        py.detach(|| tri.is_valid())
+        py.detach(|| with_s!(tri, t => t.is_valid()))
             .map(|()| true)
             .map_err(|e| PyValueError::new_err(format!("invalid triangulation: {e}")))
     }
@@ -269,24 +327,17 @@ impl SphericalTriangulation {
     /// The Voronoi cells.
     fn voronoi(&self, py: Python<'_>) -> PyResult<SphericalVoronoi> {
         let tri = Arc::clone(&self.tri);
-        let n = self.read(py)?.number_of_vertices();
+        let n = with_s!(&*self.read(py)?, t => t.number_of_vertices());
         interruptible(py, n, ("Voronoi cells", 1), move |_| {
-            let t = tri.read().map_err(poisoned)?;
-            let cells = t.voronoi_cells().map_err(value_error)?;
-            let first: Vec<Option<InputId>> = (0..t.number_of_input_points())
-                .map(|i| {
-                    let i = InputId::new(i);
-                    t.status(i).map(|s| match s {
-                        Status::Duplicate(j) => j,
-                        _ => i,
-                    })
+            let guard = tri.read().map_err(poisoned)?;
+            with_s!(&*guard, t => {
+                let cells = t.voronoi_cells().map_err(value_error)?;
+                let hidden = t.hidden().iter().map(|i| i.index()).collect();
+                Ok(SphericalVoronoi {
+                    cells,
+                    first: first_occurrences(t),
+                    hidden,
                 })
-                .collect();
-            let hidden = t.hidden().iter().map(|i| i.index()).collect();
-            Ok(SphericalVoronoi {
-                cells,
-                first,
-                hidden,
             })
         })
     }
