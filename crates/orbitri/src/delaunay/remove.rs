@@ -134,6 +134,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             if self.weighted {
                 self.weights[p.index()] = self.weights[last];
             }
+            self.relocate(p.index());
         }
         self.pop_point();
         self.vpoint.truncate(last * sheets);

@@ -24,7 +24,7 @@ use crate::predicates::Sign;
 pub struct Antipode(pub bool);
 
 /// The real projective plane, with its set of anchors (as [`Sphere::with_anchors`]).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ProjectivePlane {
     sphere: Sphere,
 }

@@ -16,9 +16,38 @@ use crate::predicates::spherical::{self, ANCHOR_SCALE};
 use crate::predicates::Sign;
 
 /// The unit sphere S², with its set of anchors ([`Sphere::with_anchors`]).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Sphere {
     anchor_set: u64,
+    /// The anchors' directions (integers).
+    directions: [[f64; 3]; 4],
+}
+
+impl Default for Sphere {
+    fn default() -> Self {
+        Sphere::with_anchors(0)
+    }
+}
+
+/// The anchor directions of set `k` (see [`Sphere::with_anchors`]).
+fn directions(k: u64) -> [[f64; 3]; 4] {
+    let mut r = crate::sort::SplitMix::new(0xa9c4_0000 ^ k);
+    loop {
+        let mut v = [[0.0; 3]; 4];
+        for t in v.iter_mut().take(3) {
+            *t = std::array::from_fn(|_| r.below(1 << 22) as f64 - (1 << 21) as f64);
+        }
+        v[3] = std::array::from_fn(|k| -(v[0][k] + v[1][k] + v[2][k]));
+        // (spanning, and no two along one line: then no three coplanar with the centre
+        // either, as each triple spans with the fourth)
+        let independent = (0..4).all(|i| {
+            let [a, b, c] = [v[(i + 1) % 4], v[(i + 2) % 4], v[(i + 3) % 4]];
+            spherical::orient_origin(&a, &b, &c) != Sign::Zero
+        });
+        if independent {
+            return v;
+        }
+    }
 }
 
 impl Sphere {
@@ -28,7 +57,10 @@ impl Sphere {
     /// direction would make a flat cell with it, which no perturbation separates; the
     /// facade picks a set that no point meets ([`Sphere::meets_anchor`]).
     pub fn with_anchors(k: u64) -> Sphere {
-        Sphere { anchor_set: k }
+        Sphere {
+            anchor_set: k,
+            directions: directions(k),
+        }
     }
 
     /// The number of the anchor set.
@@ -38,23 +70,7 @@ impl Sphere {
 
     /// The anchors' directions (integers, exact as doubles).
     pub fn anchor_directions(&self) -> [[f64; 3]; 4] {
-        let mut r = crate::sort::SplitMix::new(0xa9c4_0000 ^ self.anchor_set);
-        loop {
-            let mut v = [[0.0; 3]; 4];
-            for t in v.iter_mut().take(3) {
-                *t = std::array::from_fn(|_| r.below(1 << 22) as f64 - (1 << 21) as f64);
-            }
-            v[3] = std::array::from_fn(|k| -(v[0][k] + v[1][k] + v[2][k]));
-            // (spanning, and no two along one line: then no three coplanar with the centre
-            // either, as each triple spans with the fourth)
-            let independent = (0..4).all(|i| {
-                let [a, b, c] = [v[(i + 1) % 4], v[(i + 2) % 4], v[(i + 3) % 4]];
-                spherical::orient_origin(&a, &b, &c) != Sign::Zero
-            });
-            if independent {
-                return v;
-            }
-        }
+        self.directions
     }
 
     /// True when `p` lies exactly along (or against) one of the anchors' directions.

@@ -640,6 +640,14 @@ impl<S: SphericalSpace> SphericalTriangulation<S> {
         if self.dimension() < 2 {
             return (reps, orbit);
         }
+        if e.sheets() == 1 {
+            // stored as the space itself: every face its own orbit
+            for c in e.cell_ids().filter(|&c| self.is_face(c)) {
+                orbit[c.index()] = reps.len();
+                reps.push(c);
+            }
+            return (reps, orbit);
+        }
         let last = e.space().levels() - 1;
         let mut index: std::collections::HashMap<[(PointId, S::Elem); 3], usize> =
             std::collections::HashMap::new();
