@@ -33,10 +33,11 @@ fn neg(p: [f64; 3]) -> [f64; 3] {
     p.map(|x| -x)
 }
 
-/// A face by the bits of its three positions, the same for a face and its antipode.
+/// A face by the bits of its three positions (−0 as 0: duplicates may differ in the sign
+/// of a zero), the same for a face and its antipode.
 fn key(f: [[f64; 3]; 3]) -> [[u64; 3]; 3] {
     let sorted = |f: [[f64; 3]; 3]| {
-        let mut b = f.map(|p| p.map(f64::to_bits));
+        let mut b = f.map(|p| p.map(|x| (x + 0.0).to_bits()));
         b.sort_unstable();
         b
     };
@@ -174,4 +175,96 @@ fn a_lonlat_grid_of_the_projective_plane() {
     assert_eq!(tri.faces().len(), 2 * tri.number_of_vertices() - 2);
     let total: f64 = tri.voronoi_cells().unwrap().iter().map(|c| c.area).sum();
     assert!((total - 2.0 * PI).abs() < 1e-12);
+}
+
+mod properties {
+    use super::*;
+    use orbitri::spherical::{lonlat_to_point, SphericalSpace, SphericalTriangulation};
+    use proptest::prelude::*;
+
+    /// Points on a 30° lon/lat grid: duplicates, antipodes, poles and cocircular sets.
+    fn grid_point() -> impl Strategy<Value = [f64; 3]> {
+        (0i32..12, -3i32..=3)
+            .prop_map(|(i, j)| lonlat_to_point(0, f64::from(i * 30), f64::from(j * 30)).unwrap())
+    }
+
+    #[derive(Clone, Debug)]
+    enum Op {
+        Insert([f64; 3]),
+        Remove(usize),
+    }
+
+    fn op() -> impl Strategy<Value = Op> {
+        prop_oneof![
+            3 => grid_point().prop_map(Op::Insert),
+            1 => any::<usize>().prop_map(Op::Remove),
+        ]
+    }
+
+    /// The faces of `tri` as sets of lifted positions, the same for a face and its antipode.
+    fn faces_of<S: SphericalSpace>(tri: &SphericalTriangulation<S>) -> BTreeSet<[[u64; 3]; 3]> {
+        tri.faces()
+            .iter()
+            .zip(tri.face_signs())
+            .map(|(f, s)| {
+                key(std::array::from_fn(|k| {
+                    let p = tri.point(f[k]).unwrap();
+                    if s[k] {
+                        neg(p)
+                    } else {
+                        p
+                    }
+                }))
+            })
+            .collect()
+    }
+
+    /// Runs `ops`: valid after every step, every live input a vertex or a duplicate, and at
+    /// the end the faces of a fresh build of the live points.
+    fn run<S: SphericalSpace>(ops: &[Op]) -> Result<(), TestCaseError> {
+        let mut tri = SphericalTriangulation::<S>::new();
+        let mut given: Vec<[f64; 3]> = Vec::new();
+        let mut live: Vec<usize> = Vec::new();
+        for (step, op) in ops.iter().enumerate() {
+            match *op {
+                Op::Insert(p) => {
+                    tri.insert(p).unwrap();
+                    live.push(given.len());
+                    given.push(p);
+                }
+                Op::Remove(k) if !live.is_empty() => {
+                    let i = live.swap_remove(k % live.len());
+                    tri.remove(InputId::new(i)).unwrap();
+                }
+                Op::Remove(_) => prop_assert!(tri.remove(InputId(0)).is_err() || !given.is_empty()),
+            }
+            prop_assert!(
+                tri.is_valid().is_ok(),
+                "step {step} {op:?}: {:?}",
+                tri.is_valid()
+            );
+            prop_assert!(tri.hidden().is_empty());
+        }
+        let kept: Vec<[f64; 3]> = live.iter().map(|&i| given[i]).collect();
+        if !kept.is_empty() {
+            let fresh = SphericalTriangulation::<S>::build(&kept).unwrap();
+            prop_assert_eq!(fresh.dimension(), tri.dimension());
+            prop_assert_eq!(faces_of(&fresh), faces_of(&tri));
+        }
+        Ok(())
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig {
+            cases: std::env::var("PROPTEST_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(40),
+            ..ProptestConfig::default()
+        })]
+
+        /// Random insertions and removals on a lon/lat grid, on the sphere and on RP².
+        #[test]
+        fn random_sequences_stay_delaunay(ops in proptest::collection::vec(op(), 1..60)) {
+            run::<orbitri::Sphere>(&ops)?;
+            run::<orbitri::ProjectivePlane>(&ops)?;
+        }
+    }
 }
