@@ -50,6 +50,17 @@ pub fn canonical(p: &[f64; 3]) -> [f64; 3] {
     }
 }
 
+/// The perturbed in-circle test of four points on one circle (see
+/// [`ProjectivePlane::in_sphere`]): kept out of line, so that the filtered test inlines.
+#[cold]
+#[inline(never)]
+fn tie(s: [[f64; 3]; 3], x: [f64; 3]) -> Sign {
+    let keys = [s[0], s[1], s[2], x].map(|p| canonical(&p));
+    spherical::in_circle(&s, x, |i, j| {
+        Sign::from(keys[i].partial_cmp(&keys[j]).expect("finite coordinates"))
+    })
+}
+
 impl ProjectivePlane {
     /// The projective plane with the anchor set `k`: three of the sphere's set `k`
     /// directions (linearly independent), in canonical form.
@@ -104,12 +115,7 @@ impl OrbitSpace<3> for ProjectivePlane {
         let [a, b, c] = [at(&s[0]), at(&s[1]), at(&s[2])];
         let x = at(&q);
         match spherical::side_unit(&a, &b, &c, &x) {
-            Sign::Zero => {
-                let keys = [a, b, c, x].map(|p| canonical(&p));
-                spherical::in_circle(&[a, b, c], x, |i, j| {
-                    Sign::from(keys[i].partial_cmp(&keys[j]).expect("finite coordinates"))
-                })
-            }
+            Sign::Zero => tie([a, b, c], x),
             decided => decided,
         }
     }
