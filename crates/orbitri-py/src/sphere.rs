@@ -229,8 +229,11 @@ impl PySpherical {
     /// outside, the face across the edge opposite each vertex (−1 where the points leave a
     /// hemisphere open), and each vertex's sign (−1: the antipode of its point, in RP²).
     fn faces<'py>(&self, py: Python<'py>) -> PyResult<Faces<'py>> {
-        let (faces, neighbors, signs) =
-            with_s!(&*self.read(py)?, t => (t.faces(), t.neighbors(), t.face_signs()));
+        let orbitri::spherical::FaceTable {
+            faces,
+            signs,
+            neighbors,
+        } = with_s!(&*self.read(py)?, t => t.face_table());
         let f: Vec<i64> = faces.iter().flatten().map(|i| i64::from(i.0)).collect();
         let n: Vec<i64> = neighbors
             .iter()

@@ -31,11 +31,10 @@ pub fn write_sphere_cells<S: SphericalSpace>(
     w: &mut impl Write,
     tri: &SphericalTriangulation<S>,
 ) -> std::io::Result<()> {
-    let faces = tri.faces();
-    writeln!(w, "1 {} {}", tri.number_of_vertices(), faces.len())?;
-    let projective = S::AREA < 4.0 * std::f64::consts::PI;
-    for ([a, b, c], s) in faces.into_iter().zip(tri.face_signs()) {
-        if projective {
+    let table = tri.face_table();
+    writeln!(w, "1 {} {}", tri.number_of_vertices(), table.faces.len())?;
+    for ([a, b, c], s) in table.faces.into_iter().zip(table.signs) {
+        if S::ANTIPODAL {
             let [x, y, z] = s.map(|n| if n { -1 } else { 1 });
             writeln!(w, "{a} {b} {c} {x} {y} {z}")?;
         } else {
@@ -70,9 +69,10 @@ pub fn write_sphere_json<S: SphericalSpace>(
         let s: Vec<String> = v.iter().map(|x| x.to_string()).collect();
         format!("[{}]", s.join(","))
     };
-    let faces: Vec<String> = tri.faces().iter().map(|f| ids(f)).collect();
-    let neighbors: Vec<String> = tri
-        .neighbors()
+    let table = tri.face_table();
+    let faces: Vec<String> = table.faces.iter().map(|f| ids(f)).collect();
+    let neighbors: Vec<String> = table
+        .neighbors
         .iter()
         .map(|n| {
             let s: Vec<String> = n
@@ -82,8 +82,8 @@ pub fn write_sphere_json<S: SphericalSpace>(
             format!("[{}]", s.join(","))
         })
         .collect();
-    let signs: Vec<String> = tri
-        .face_signs()
+    let signs: Vec<String> = table
+        .signs
         .iter()
         .map(|s| format!("[{}]", s.map(|n| if n { "-1" } else { "1" }).join(",")))
         .collect();
@@ -247,7 +247,8 @@ pub fn write_sphere_faces_vtu<S: SphericalSpace>(
     // one point per (input, sign): a face of RP² may use a point's antipode
     let mut index: std::collections::HashMap<(InputId, bool), i64> = Default::default();
     let mut pid = Vec::new();
-    for (f, signs) in tri.faces().into_iter().zip(tri.face_signs()) {
+    let table = tri.face_table();
+    for (f, signs) in table.faces.into_iter().zip(table.signs) {
         for (i, s) in f.into_iter().zip(signs) {
             let id = *index.entry((i, s)).or_insert_with(|| {
                 let p = tri.point(i).expect("a vertex is live");
@@ -320,11 +321,7 @@ pub fn write_sphere_svg<S: SphericalSpace>(
     let n = tri.number_of_vertices().max(1) as f64;
     let stroke = (width / n.sqrt() / 25.0).clamp(0.15, 1.5);
     // the copies drawn: the point itself, and on RP² its antipode
-    let copies: &[f64] = if S::AREA < 4.0 * std::f64::consts::PI {
-        &[1.0, -1.0]
-    } else {
-        &[1.0]
-    };
+    let copies: &[f64] = if S::ANTIPODAL { &[1.0, -1.0] } else { &[1.0] };
     writeln!(
         w,
         r#"<svg xmlns="http://www.w3.org/2000/svg" width="{width:.0}" height="{height:.0}" viewBox="0 0 {width:.2} {height:.2}">"#
@@ -365,7 +362,8 @@ pub fn write_sphere_svg<S: SphericalSpace>(
     if opts.delaunay {
         // each edge once (an edge of a hemisphere's rim has one face), by its lifted ends
         let mut all: Vec<[[u64; 3]; 2]> = Vec::new();
-        for (f, signs) in tri.faces().iter().zip(tri.face_signs()) {
+        let table = tri.face_table();
+        for (f, signs) in table.faces.iter().zip(table.signs) {
             let q = std::array::from_fn::<_, 3, _>(|k| {
                 times(point(f[k]), if signs[k] { -1.0 } else { 1.0 })
             });

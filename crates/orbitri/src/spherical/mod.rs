@@ -136,6 +136,8 @@ pub trait SphericalSpace:
     fn is_antipode(g: Self::Elem) -> bool;
     /// The area of the space: 4π, 2π.
     const AREA: f64;
+    /// True when a point and its antipode are one point (the projective plane).
+    const ANTIPODAL: bool;
     /// The space's name in outputs (`--space` of the command).
     const NAME: &'static str;
 }
@@ -157,6 +159,7 @@ impl SphericalSpace for Sphere {
         false
     }
     const AREA: f64 = 4.0 * std::f64::consts::PI;
+    const ANTIPODAL: bool = false;
     const NAME: &'static str = "sphere";
 }
 
@@ -181,6 +184,7 @@ impl SphericalSpace for ProjectivePlane {
         g.0
     }
     const AREA: f64 = 2.0 * std::f64::consts::PI;
+    const ANTIPODAL: bool = true;
     const NAME: &'static str = "projective-plane";
 }
 
@@ -222,6 +226,17 @@ fn check_point(index: usize, p: &[f64; 3]) -> Result<()> {
         });
     }
     Ok(())
+}
+
+/// The faces of a spherical triangulation ([`SphericalTriangulation::face_table`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct FaceTable {
+    /// Input ids, counter-clockwise seen from outside once lifted by the signs.
+    pub faces: Vec<[InputId; 3]>,
+    /// Per vertex, whether the face uses the antipode of its stored point.
+    pub signs: Vec<[bool; 3]>,
+    /// Per edge (opposite vertex `k`), the face across, `None` beyond the faces.
+    pub neighbors: Vec<[Option<usize>; 3]>,
 }
 
 /// The Delaunay triangulation of points on the unit sphere ([`SphericalDelaunay`]), or of
@@ -606,28 +621,38 @@ impl<S: SphericalSpace> SphericalTriangulation<S> {
             .all(|&v| e.point_of(v).index() >= anchors)
     }
 
+    /// The faces with their signs and neighbours, from one pass over the cells (what
+    /// [`Self::faces`], [`Self::face_signs`] and [`Self::neighbors`] give one by one).
+    pub fn face_table(&self) -> FaceTable {
+        let e = &self.engine;
+        let (reps, orbit) = self.face_orbits();
+        let cells = || reps.iter().map(|&c| e.cell(c));
+        FaceTable {
+            faces: cells()
+                .map(|cell| cell.v.map(|v| self.point_input[e.point_of(v).index()]))
+                .collect(),
+            signs: cells().map(|cell| cell.off.map(S::is_antipode)).collect(),
+            neighbors: cells()
+                .map(|cell| {
+                    cell.n
+                        .map(|d| Some(orbit[d.index()]).filter(|&k| k != usize::MAX))
+                })
+                .collect(),
+        }
+    }
+
     /// The faces (CGAL's solid faces) by input ids of their vertices, counter-clockwise
     /// seen from outside (in RP², the lifted face `signs·points`: [`Self::face_signs`]);
     /// none when [`Self::dimension`] is below 2. One per face of the space, also while the
     /// projective plane is stored in its covering sphere.
     pub fn faces(&self) -> Vec<[InputId; 3]> {
-        let e = &self.engine;
-        self.face_orbits()
-            .0
-            .iter()
-            .map(|&c| e.cell(c).v.map(|v| self.point_input[e.point_of(v).index()]))
-            .collect()
+        self.face_table().faces
     }
 
     /// Per face of [`Self::faces`], whether each vertex is the antipode of its stored
     /// point (always false on the sphere). At most one per face is.
     pub fn face_signs(&self) -> Vec<[bool; 3]> {
-        let e = &self.engine;
-        self.face_orbits()
-            .0
-            .iter()
-            .map(|&c| e.cell(c).off.map(S::is_antipode))
-            .collect()
+        self.face_table().signs
     }
 
     /// The faces of the space (one stored cell per orbit, the copy in the quotient's
@@ -675,15 +700,7 @@ impl<S: SphericalSpace> SphericalTriangulation<S> {
     /// vertex `k`), `None` beyond the faces (where the hull turns its outer side to the
     /// centre: the points lie in a hemisphere).
     pub fn neighbors(&self) -> Vec<[Option<usize>; 3]> {
-        let (reps, orbit) = self.face_orbits();
-        reps.iter()
-            .map(|&c| {
-                self.engine
-                    .cell(c)
-                    .n
-                    .map(|d| Some(orbit[d.index()]).filter(|&k| k != usize::MAX))
-            })
-            .collect()
+        self.face_table().neighbors
     }
 
     /// The Delaunay neighbours of input `i` (vertices joined to it by an edge of a face),
