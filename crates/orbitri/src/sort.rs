@@ -26,6 +26,19 @@ impl SplitMix {
         (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
     }
 
+    /// A point uniform on the unit sphere, as the CGAL anchor harness's `gens` draws it:
+    /// `2u − 1` per coordinate until `0 < |v|² ≤ 1`, then `v/|v|`.
+    pub fn on_sphere(&mut self) -> [f64; 3] {
+        loop {
+            let v = [0, 1, 2].map(|_| 2.0 * self.unit() - 1.0);
+            let s = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+            if s > 0.0 && s <= 1.0 {
+                let r = s.sqrt();
+                return v.map(|x| x / r);
+            }
+        }
+    }
+
     /// An integer in `[0, n)`.
     #[inline]
     pub fn below(&mut self, n: usize) -> usize {
@@ -190,6 +203,24 @@ mod tests {
             let x = [0, 1].map(|_| r.below(1 << bits) as u32);
             assert_eq!(hilbert(x, bits), skilling2(x, bits), "{x:?} {bits}");
         }
+    }
+
+    #[test]
+    fn sphere_points_match_the_anchor() {
+        // the first two lines of `cgal_anchor gens N 1` (shortest round-trip digits)
+        let mut r = SplitMix::new(1);
+        assert_eq!(
+            r.on_sphere(),
+            [
+                -0.20274504021579695,
+                -0.20308944041506807,
+                0.9579400439796791
+            ]
+        );
+        assert_eq!(
+            r.on_sphere(),
+            [0.868143729616118, 0.05306929174520203, -0.49346744067048565]
+        );
     }
 
     #[test]

@@ -14,19 +14,7 @@ use orbitri::{Error, InputId};
 
 fn random_points(n: usize, seed: u64) -> Vec<[f64; 3]> {
     let mut r = SplitMix::new(seed);
-    (0..n)
-        .map(|_| loop {
-            let v = [
-                r.unit() * 2.0 - 1.0,
-                r.unit() * 2.0 - 1.0,
-                r.unit() * 2.0 - 1.0,
-            ];
-            let n = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
-            if n > 0.01 && n <= 1.0 {
-                break v.map(|x| x / n.sqrt());
-            }
-        })
-        .collect()
+    (0..n).map(|_| r.on_sphere()).collect()
 }
 
 fn neg(p: [f64; 3]) -> [f64; 3] {

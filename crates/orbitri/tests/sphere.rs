@@ -12,23 +12,9 @@ use orbitri::sort::SplitMix;
 use orbitri::spherical::{lonlat_to_point, normalized, SphericalDelaunay, Status};
 use orbitri::{Error, InputId};
 
-fn random_unit(r: &mut SplitMix) -> [f64; 3] {
-    loop {
-        let v = [
-            r.unit() * 2.0 - 1.0,
-            r.unit() * 2.0 - 1.0,
-            r.unit() * 2.0 - 1.0,
-        ];
-        let n = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
-        if n > 0.01 && n <= 1.0 {
-            return v.map(|x| x / n.sqrt());
-        }
-    }
-}
-
 fn random_points(n: usize, seed: u64) -> Vec<[f64; 3]> {
     let mut r = SplitMix::new(seed);
-    (0..n).map(|_| random_unit(&mut r)).collect()
+    (0..n).map(|_| r.on_sphere()).collect()
 }
 
 /// A face as a rotation-invariant key: its least id first, the cyclic order kept.

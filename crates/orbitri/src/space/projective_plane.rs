@@ -265,20 +265,6 @@ mod tests {
     use crate::delaunay::Engine;
     use crate::sort::SplitMix;
 
-    fn unit(r: &mut SplitMix) -> [f64; 3] {
-        loop {
-            let v = [
-                r.unit() * 2.0 - 1.0,
-                r.unit() * 2.0 - 1.0,
-                r.unit() * 2.0 - 1.0,
-            ];
-            let n = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
-            if n > 0.01 && n <= 1.0 {
-                return canonical(&v.map(|x| x / n.sqrt()));
-            }
-        }
-    }
-
     /// A face of S² or RP² by the bits of its lifted vertices, the same for a face and its
     /// antipode.
     fn key(f: [[f64; 3]; 3]) -> [[u64; 3]; 3] {
@@ -300,7 +286,7 @@ mod tests {
     #[test]
     fn the_quotient_is_the_sphere_of_both_copies_projected() {
         let mut r = SplitMix::new(6);
-        let pts: Vec<[f64; 3]> = (0..600).map(|_| unit(&mut r)).collect();
+        let pts: Vec<[f64; 3]> = (0..600).map(|_| canonical(&r.on_sphere())).collect();
         let mut e = Engine::new(ProjectivePlane::default());
         let mut switched = None;
         for (k, p) in pts.iter().enumerate() {

@@ -309,20 +309,6 @@ mod tests {
     use crate::delaunay::Engine;
     use crate::sort::SplitMix;
 
-    fn unit(r: &mut SplitMix) -> [f64; 3] {
-        loop {
-            let v = [
-                r.unit() * 2.0 - 1.0,
-                r.unit() * 2.0 - 1.0,
-                r.unit() * 2.0 - 1.0,
-            ];
-            let n = dot(&v, &v);
-            if n > 0.01 && n <= 1.0 {
-                return v.map(|x| x / n.sqrt());
-            }
-        }
-    }
-
     #[test]
     fn anchors_alone_are_a_valid_sphere() {
         let e = Engine::new(Sphere::default());
@@ -336,7 +322,7 @@ mod tests {
         let mut e = Engine::new(Sphere::default());
         let mut r = SplitMix::new(1);
         for k in 0..500 {
-            e.insert(unit(&mut r));
+            e.insert(r.on_sphere());
             if k < 12 || k % 50 == 0 {
                 e.is_valid().unwrap();
             }

@@ -797,9 +797,7 @@ mod tests {
         ];
         let mut r = SplitMix::new(8);
         for _ in 0..200 {
-            let v = [r.unit() - 0.5, r.unit() - 0.5, r.unit() - 0.5];
-            let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-            pts.push(v.map(|x| x / n));
+            pts.push(r.on_sphere());
         }
         let space = anchors_for::<Sphere>(pts.iter());
         assert_ne!(space.anchor_set(), 0);
