@@ -89,9 +89,26 @@ class SphericalDelaunay:
 
     @property
     def neighbors(self) -> np.ndarray:
-        """The face across each edge (F × 3): ``neighbors[f, k]`` is opposite vertex ``k``;
-        −1 where the points leave a hemisphere open (see ``covers_sphere``)."""
-        return self._arrays()[1]
+        """The face across each edge (F × 3): ``neighbors[f, k]`` is opposite vertex ``k``.
+        For points in a closed hemisphere (``covers_sphere`` false) the rim's faces border
+        ghost faces: an index ``g ≥ F`` is ``ghost_simplices[g − F]``."""
+        faces = self._arrays()
+        return faces[1][: len(faces[0])]
+
+    @property
+    def ghost_simplices(self) -> np.ndarray:
+        """CGAL's ghost faces (G × 3; none when the points enclose the centre): for points
+        in a closed hemisphere, the faces of their convex hull that do not hold the centre
+        strictly inside, counter-clockwise seen from outside the hull. With ``simplices``
+        they close up into the whole hull; the Voronoi cells pass through their poles."""
+        return self._arrays()[3]
+
+    @property
+    def ghost_neighbors(self) -> np.ndarray:
+        """The face across each edge of each ghost face (G × 3), numbered as in
+        ``neighbors``: below F a face, from F on a ghost face."""
+        faces = self._arrays()
+        return faces[1][len(faces[0]) :]
 
     @property
     def signs(self) -> np.ndarray:

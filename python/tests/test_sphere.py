@@ -39,6 +39,25 @@ def test_faces_equal_qhull_and_areas_equal_scipy(seed):
         assert ours == theirs
 
 
+def test_hemisphere_ghost_faces_close_the_hull_and_cells_equal_scipy():
+    spatial = pytest.importorskip("scipy.spatial")
+    pts = unit(2000, 4)
+    pts[:, 2] = np.abs(pts[:, 2])
+    tri = orbitri.SphericalDelaunay(pts)
+    assert tri.dimension == 2 and not tri.covers_sphere
+    hull = spatial.ConvexHull(pts)
+    assert triangles(np.vstack([tri.simplices, tri.ghost_simplices])) == triangles(
+        hull.simplices
+    )
+    # the ghost faces turn towards the centre
+    a, b, c = (pts[tri.ghost_simplices[:, k]] for k in range(3))
+    assert (np.einsum("ij,ij->i", a, np.cross(b, c)) < 0).all()
+    vor = tri.voronoi()
+    sv = spatial.SphericalVoronoi(pts)
+    np.testing.assert_allclose(vor.areas, sv.calculate_areas(), rtol=0, atol=1e-9)
+    assert abs(vor.areas.sum() - 4 * np.pi) < 1e-12
+
+
 def test_neighbours_across_faces_are_mutual():
     tri = orbitri.SphericalDelaunay(unit(500, 5))
     s, n = tri.simplices, tri.neighbors
@@ -71,11 +90,15 @@ def test_small_sets_and_a_hemisphere():
     assert tri.dimension == -1 and len(tri.simplices) == 0
     tri.insert([[0.0, 1.0, 0.0], [0.6, 0.8, 0.0]])
     assert tri.dimension == 1
+    with pytest.raises(ValueError, match="no faces"):
+        tri.voronoi()
     tri.insert([[0.0, 0.0, 1.0]])
     assert tri.dimension == 2 and not tri.covers_sphere
-    with pytest.raises(ValueError, match="hemisphere"):
-        tri.voronoi()
-    assert (tri.neighbors == -1).any()
+    # a tetrahedron: two faces hold the centre inside; the equator's and the one facing
+    # the centre are ghost faces
+    assert len(tri.simplices) == 2 and len(tri.ghost_simplices) == 2
+    assert set(tri.neighbors.ravel()) | set(tri.ghost_neighbors.ravel()) == {0, 1, 2, 3}
+    assert tri.voronoi().areas.sum() == pytest.approx(4 * np.pi, abs=1e-12)
     tri.insert([[-0.5, -0.5, -(0.5**0.5)]])
     assert tri.covers_sphere and len(tri.simplices) == 6
     assert tri.voronoi().areas.sum() == pytest.approx(4 * np.pi, abs=1e-12)

@@ -1419,10 +1419,29 @@ fn the_sphere_from_the_command_line() {
         &["--normalize", "--stats", "-o", &path("n.cells")],
     );
     assert!(stderr(&o).contains("dimension=1"), "{}", stderr(&o));
-    // a hemisphere has no Voronoi diagram of its faces alone: a typed error
+    // three points on one plane have no faces, so no Voronoi cells: a typed error
     let o = on_sphere("voronoi", &off, &["--normalize"]);
     assert_eq!(o.status.code(), Some(2));
-    assert!(stderr(&o).contains("hemisphere"), "{}", stderr(&o));
+    assert!(stderr(&o).contains("no faces"), "{}", stderr(&o));
+    // a hemisphere: ghost faces in the JSON, and cells through their poles
+    let hemi = write(dir.path(), "hemi.txt", "1 0 0\n0 1 0\n0 0 1\n0.6 0.8 0\n");
+    let o = on_sphere("triangulate", &hemi, &["-o", &path("h.json")]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let json = std::fs::read_to_string(path("h.json")).unwrap();
+    assert!(json.contains("\"covers_sphere\":false"), "{json}");
+    assert!(json.contains("\"ghost_faces\":[["), "{json}");
+    let o = on_sphere("voronoi", &hemi, &["-o", &path("h.csv")]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let areas: f64 = std::fs::read_to_string(path("h.csv"))
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(1).unwrap().parse::<f64>().unwrap())
+        .sum();
+    assert!(
+        (areas - 4.0 * std::f64::consts::PI).abs() < 1e-12,
+        "{areas}"
+    );
     // a box given to the sphere, --lonlat given to a torus, a torus without its box
     let o = on_sphere("triangulate", &off, &["--box", "1", "1", "1"]);
     assert!(stderr(&o).contains("has no box"), "{}", stderr(&o));

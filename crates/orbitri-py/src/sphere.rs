@@ -109,8 +109,9 @@ impl PySpherical {
     }
 }
 
-/// Faces, their neighbours and their vertices' signs.
+/// Faces, their neighbours, their vertices' signs, and the ghost faces.
 type Faces<'py> = (
+    Bound<'py, PyArray2<i64>>,
     Bound<'py, PyArray2<i64>>,
     Bound<'py, PyArray2<i64>>,
     Bound<'py, PyArray2<i64>>,
@@ -136,11 +137,6 @@ fn first_occurrences<S: SphericalSpace>(t: &SphericalTriangulation<S>) -> Vec<Op
             })
         })
         .collect()
-}
-
-/// `None` → −1, for index arrays.
-fn or_minus_one(x: Option<usize>) -> i64 {
-    x.map_or(-1, |k| k as i64)
 }
 
 #[pymethods]
@@ -225,21 +221,21 @@ impl PySpherical {
         Ok(with_s!(&*self.read(py)?, t => t.number_of_vertices()))
     }
 
-    /// `(faces F × 3, neighbours F × 3, signs F × 3)`: input ids counter-clockwise seen from
-    /// outside, the face across the edge opposite each vertex (−1 where the points leave a
-    /// hemisphere open), and each vertex's sign (−1: the antipode of its point, in RP²).
+    /// `(faces F × 3, neighbours (F + G) × 3, signs F × 3, ghost faces G × 3)`: input ids
+    /// counter-clockwise seen from outside; per face, then per ghost face, the face across
+    /// the edge opposite each vertex (ghost faces numbered from F); each vertex's sign (−1:
+    /// the antipode of its point, in RP²); CGAL's ghost faces (points in a hemisphere).
     fn faces<'py>(&self, py: Python<'py>) -> PyResult<Faces<'py>> {
         let orbitri::spherical::FaceTable {
             faces,
             signs,
+            ghosts,
             neighbors,
         } = with_s!(&*self.read(py)?, t => t.face_table());
-        let f: Vec<i64> = faces.iter().flatten().map(|i| i64::from(i.0)).collect();
-        let n: Vec<i64> = neighbors
-            .iter()
-            .flatten()
-            .map(|&k| or_minus_one(k))
-            .collect();
+        let ids = |f: &[[orbitri::InputId; 3]]| -> Vec<i64> {
+            f.iter().flatten().map(|i| i64::from(i.0)).collect()
+        };
+        let n: Vec<i64> = neighbors.iter().flatten().map(|&k| k as i64).collect();
         let s: Vec<i64> = signs
             .iter()
             .flatten()
@@ -247,9 +243,10 @@ impl PySpherical {
             .collect();
         let k = faces.len();
         Ok((
-            array2(py, k, 3, f),
-            array2(py, k, 3, n),
+            array2(py, k, 3, ids(&faces)),
+            array2(py, neighbors.len(), 3, n),
             array2(py, k, 3, s),
+            array2(py, ghosts.len(), 3, ids(&ghosts)),
         ))
     }
 

@@ -25,11 +25,11 @@ pub enum Error {
         "point {index}: its norm is {norm}, not 1: points on the sphere must be unit vectors (to within 1e-6), or give them as longitude and latitude, or normalize them"
     )]
     OffSphere { index: usize, norm: f64 },
-    /// A spherical Voronoi diagram asked of points that do not enclose the centre.
+    /// A spherical Voronoi diagram asked of points with no faces (below dimension 2).
     #[error(
-        "the {points} points lie in one closed hemisphere (the triangulation has dimension {dimension}, or faces turn their outer side to the centre): their Voronoi cells are not bounded by the faces alone"
+        "the {points} points have no faces (dimension {dimension}: at most two points, or all on one circle): spherical Voronoi cells are dual to faces and need three points off one circle"
     )]
-    Hemisphere { points: usize, dimension: i32 },
+    NoFaces { points: usize, dimension: i32 },
     #[error("the input holds no points")]
     EmptyInput,
     #[error("invalid box: {0}")]

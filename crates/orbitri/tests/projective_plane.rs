@@ -114,7 +114,7 @@ fn antipodes_are_one_point_and_small_sets_have_their_dimension() {
     assert!(tri.faces().is_empty());
     assert!(matches!(
         tri.voronoi_cells(),
-        Err(Error::Hemisphere { dimension: 1, .. })
+        Err(Error::NoFaces { dimension: 1, .. })
     ));
     tri.is_valid().unwrap();
     tri.insert([0.0, 0.0, -1.0]).unwrap();

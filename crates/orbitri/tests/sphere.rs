@@ -43,8 +43,9 @@ fn check_empty(tri: &SphericalDelaunay, pts: &[[f64; 3]]) {
     }
 }
 
-/// The faces of the hull by brute force over all triples (points in general position).
-fn brute_hull(pts: &[[f64; 3]]) -> BTreeSet<[u32; 3]> {
+/// The faces of the hull by brute force over all triples (points in general position):
+/// those that hold the centre strictly inside, or with `ghosts` all of them.
+fn brute_hull(pts: &[[f64; 3]], ghosts: bool) -> BTreeSet<[u32; 3]> {
     let n = pts.len();
     let mut out = BTreeSet::new();
     for i in 0..n {
@@ -54,7 +55,7 @@ fn brute_hull(pts: &[[f64; 3]]) -> BTreeSet<[u32; 3]> {
                     continue;
                 }
                 let (a, b, c) = (&pts[i], &pts[j], &pts[k]);
-                if orient_origin(a, b, c) != Sign::Positive {
+                if !ghosts && orient_origin(a, b, c) != Sign::Positive {
                     continue;
                 }
                 if pts
@@ -76,7 +77,7 @@ fn random_faces_equal_the_brute_force_hull() {
         let tri = SphericalDelaunay::build(&pts).unwrap();
         assert_eq!(tri.dimension(), 2);
         assert!(tri.covers_sphere());
-        assert_eq!(face_set(&tri), brute_hull(&pts), "seed {seed}");
+        assert_eq!(face_set(&tri), brute_hull(&pts, false), "seed {seed}");
     }
     let pts = random_points(3000, 7);
     let tri = SphericalDelaunay::build(&pts).unwrap();
@@ -188,10 +189,7 @@ fn small_sets_and_hemispheres_follow_cgal() {
     // four points in a hemisphere: the faces that face away from the centre only
     assert!(!tri.covers_sphere());
     check_empty(&tri, &[e[0], e[1], e[3], e[2]]);
-    assert!(matches!(
-        tri.voronoi_cells(),
-        Err(Error::Hemisphere { points: 4, .. })
-    ));
+    check_closed(&tri, &[e[0], e[1], e[3], e[2]]);
     // the south pole alone does not enclose the centre (every point has x ≥ 0) ...
     tri.insert([0.0, 0.0, -1.0]).unwrap();
     assert!(!tri.covers_sphere());
@@ -211,9 +209,137 @@ fn small_sets_and_hemispheres_follow_cgal() {
     let tri = SphericalDelaunay::build(&pts).unwrap();
     assert!(!tri.covers_sphere());
     check_empty(&tri, &pts);
-    assert_eq!(face_set(&tri), brute_hull(&pts));
+    assert_eq!(face_set(&tri), brute_hull(&pts, false));
     // and every point is a vertex
     assert_eq!(tri.number_of_vertices(), 60);
+}
+
+/// The faces and ghost faces close up: no point strictly beyond a ghost face, which does
+/// not hold the centre strictly inside; every directed edge once, its reverse once, and
+/// the neighbours across them; `2V − 4` faces in all; the Voronoi cells tile the sphere.
+fn check_closed(tri: &SphericalDelaunay, pts: &[[f64; 3]]) {
+    check_empty(tri, pts);
+    let (faces, ghosts) = (tri.faces(), tri.ghost_faces());
+    for f in &ghosts {
+        let [a, b, c] = f.map(|i| pts[i.index()]);
+        assert_ne!(orient_origin(&a, &b, &c), Sign::Positive, "{f:?}");
+        for q in pts {
+            assert_ne!(side_of_circle(&a, &b, &c, q), Sign::Positive, "{f:?}");
+        }
+    }
+    let all: Vec<[InputId; 3]> = faces.iter().chain(&ghosts).copied().collect();
+    assert_eq!(all.len(), 2 * tri.number_of_vertices() - 4);
+    let mut edges = std::collections::HashMap::new();
+    for (n, f) in all.iter().enumerate() {
+        for k in 0..3 {
+            assert!(edges.insert((f[k], f[(k + 1) % 3]), n).is_none(), "{f:?}");
+        }
+    }
+    for (f, across) in all.iter().zip(tri.neighbors()) {
+        for k in 0..3 {
+            assert_eq!(edges[&(f[(k + 2) % 3], f[(k + 1) % 3])], across[k]);
+        }
+    }
+    let cells = tri.voronoi_cells().unwrap();
+    let total: f64 = cells.iter().map(|c| c.area).sum();
+    assert!((total - 4.0 * PI).abs() < 1e-12 * 4.0 * PI, "{total}");
+    let dot = |a: &[f64; 3], b: &[f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    for c in &cells {
+        let s = pts[c.site.index()];
+        assert!(c.area > 0.0);
+        for (k, v) in c.vertices.iter().enumerate() {
+            let n = pts[c.neighbors[k].index()];
+            assert!((dot(v, &s) - dot(v, &n)).abs() < 1e-12);
+            // no site nearer to a vertex than its own
+            for q in pts {
+                assert!(dot(v, q) <= dot(v, &s) + 1e-12);
+            }
+        }
+    }
+}
+
+#[test]
+fn ghost_faces_close_hemispheres() {
+    // a random hemisphere: with the ghost faces, the whole brute-force hull
+    let pts: Vec<[f64; 3]> = random_points(200, 8)
+        .into_iter()
+        .map(|p| [p[0], p[1], p[2].abs()])
+        .collect();
+    let tri = SphericalDelaunay::build(&pts).unwrap();
+    check_closed(&tri, &pts);
+    let hull: BTreeSet<[u32; 3]> = tri
+        .faces()
+        .into_iter()
+        .chain(tri.ghost_faces())
+        .map(key)
+        .collect();
+    assert_eq!(hull, brute_hull(&pts, true));
+
+    // the equator's axis points and the north pole: the square through the centre is
+    // fanned from its greatest vertex, (1, 0, 0)
+    let mut pts = vec![
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [-1.0, 0.0, 0.0],
+        [0.0, -1.0, 0.0],
+    ];
+    pts.push([0.0, 0.0, 1.0]);
+    let tri = SphericalDelaunay::build(&pts).unwrap();
+    check_closed(&tri, &pts);
+    let ghosts: BTreeSet<[u32; 3]> = tri.ghost_faces().into_iter().map(key).collect();
+    assert_eq!(ghosts, BTreeSet::from([[0, 2, 1], [0, 3, 2]]));
+
+    // grids: a hemisphere with its rim on the equator, a cap (its rim a small circle),
+    // an octant (a rim on three great circles, the centre outside), a lune
+    let grid = |lon: std::ops::RangeInclusive<i32>, lat: std::ops::RangeInclusive<i32>| {
+        let mut out = Vec::new();
+        for i in lon {
+            for j in lat.clone() {
+                out.push(lonlat_to_point(0, i as f64 * 10.0, j as f64 * 10.0).unwrap());
+            }
+        }
+        out
+    };
+    for (name, pts) in [
+        ("hemisphere", grid(0..=35, 0..=9)),
+        ("cap", grid(0..=35, 3..=9)),
+        ("octant", grid(0..=9, 0..=9)),
+        ("lune", grid(0..=18, -9..=9)),
+    ] {
+        let tri = SphericalDelaunay::build(&pts).unwrap();
+        assert!(!tri.covers_sphere(), "{name}");
+        assert!(!tri.ghost_faces().is_empty(), "{name}");
+        check_closed(&tri, &pts);
+        // the faces do not depend on the order
+        let mut shuffled: Vec<usize> = (0..pts.len()).collect();
+        let mut r = SplitMix::new(3);
+        for k in (1..shuffled.len()).rev() {
+            shuffled.swap(k, r.below(k + 1));
+        }
+        let other = SphericalDelaunay::build(&shuffled.iter().map(|&k| pts[k]).collect::<Vec<_>>())
+            .unwrap();
+        let coords =
+            |tri: &SphericalDelaunay, order: &dyn Fn(usize) -> usize| -> BTreeSet<[[u64; 3]; 3]> {
+                tri.ghost_faces()
+                    .into_iter()
+                    // (the poles repeat, with zeros of either sign)
+                    .map(|f| coords_key(f.map(|i| pts[order(i.index())].map(|x| x + 0.0))))
+                    .collect()
+            };
+        assert_eq!(
+            coords(&tri, &|i| i),
+            coords(&other, &|i| shuffled[i]),
+            "{name}"
+        );
+    }
+
+    // four points in a cap of 1e-3 radians
+    let pts: Vec<[f64; 3]> = [(0.0, 0.0), (1e-3, 0.0), (0.0, 1e-3), (-7e-4, -7e-4)]
+        .iter()
+        .map(|&(x, y): &(f64, f64)| [x, y, (1.0 - x * x - y * y).sqrt()])
+        .collect();
+    let tri = SphericalDelaunay::build(&pts).unwrap();
+    check_closed(&tri, &pts);
 }
 
 #[test]

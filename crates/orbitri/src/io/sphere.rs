@@ -48,8 +48,9 @@ pub fn write_sphere_cells<S: SphericalSpace>(
 /// `"covers_sphere"`, `"points"` (input order as stored, `null` for removed ones),
 /// `"first_occurrence"` (`-1` for removed), `"hidden"`, `"faces"` (input ids,
 /// counter-clockwise from outside), `"signs"` (per face vertex, `-1` for an antipode) and
-/// `"neighbors"` (per face, the face across each edge `k` opposite vertex `k`, `-1` where
-/// the points leave a hemisphere open)`}`.
+/// `"ghost_faces"` (CGAL's, for points in a closed hemisphere: the hull's faces that do not
+/// hold the centre strictly inside) and `"neighbors"` (per face, then per ghost face, the
+/// face across each edge `k` opposite vertex `k`, ghost faces numbered after the faces)`}`.
 pub fn write_sphere_json<S: SphericalSpace>(
     w: &mut impl Write,
     tri: &SphericalTriangulation<S>,
@@ -71,14 +72,12 @@ pub fn write_sphere_json<S: SphericalSpace>(
     };
     let table = tri.face_table();
     let faces: Vec<String> = table.faces.iter().map(|f| ids(f)).collect();
+    let ghosts: Vec<String> = table.ghosts.iter().map(|f| ids(f)).collect();
     let neighbors: Vec<String> = table
         .neighbors
         .iter()
         .map(|n| {
-            let s: Vec<String> = n
-                .iter()
-                .map(|k| k.map_or("-1".into(), |k| k.to_string()))
-                .collect();
+            let s: Vec<String> = n.iter().map(|k| k.to_string()).collect();
             format!("[{}]", s.join(","))
         })
         .collect();
@@ -89,7 +88,7 @@ pub fn write_sphere_json<S: SphericalSpace>(
         .collect();
     writeln!(
         w,
-        "{{\"space\":\"{}\",\"dimension\":{},\"covers_sphere\":{},\"points\":[{}],\"first_occurrence\":[{}],\"hidden\":{},\"faces\":[{}],\"signs\":[{}],\"neighbors\":[{}]}}",
+        "{{\"space\":\"{}\",\"dimension\":{},\"covers_sphere\":{},\"points\":[{}],\"first_occurrence\":[{}],\"hidden\":{},\"faces\":[{}],\"signs\":[{}],\"ghost_faces\":[{}],\"neighbors\":[{}]}}",
         S::NAME,
         tri.dimension(),
         tri.covers_sphere(),
@@ -98,6 +97,7 @@ pub fn write_sphere_json<S: SphericalSpace>(
         ids(&tri.hidden()),
         faces.join(","),
         signs.join(","),
+        ghosts.join(","),
         neighbors.join(",")
     )
 }

@@ -45,10 +45,12 @@ impl From<std::cmp::Ordering> for Sign {
 }
 
 /// The symbolic perturbation of a cospherical in-sphere test for a given order of the
-/// points (lifted points of a flat space, or points of the sphere) (`compare(a, b)` on indices, `N` meaning the query): from the largest down,
-/// the first non-zero coefficient of the perturbed determinant, the orientation of `s` with
-/// that point replaced by `q`. The order must be invariant under the group of the space, so
-/// that every copy of a configuration gets the same answer.
+/// points (lifted points of a flat space, or points of the sphere; `compare(a, b)` on
+/// indices, `N` meaning the query): from the largest down, the first non-zero coefficient
+/// of the perturbed determinant, the orientation of `s` with that point replaced by `q`,
+/// and for the query itself minus the orientation of `s` (`Zero` only when `s` is flat:
+/// every coefficient then vanishes). The order must be invariant under the group of the
+/// space, so that every copy of a configuration gets the same answer.
 pub(crate) fn perturbed_by<T: Copy, const N: usize>(
     s: &[T; N],
     q: T,
@@ -65,8 +67,8 @@ pub(crate) fn perturbed_by<T: Copy, const N: usize>(
     }
     for &idx in order.iter().rev() {
         if idx == N {
-            // the query's own coefficient is the orientation of `s`: positive
-            return Sign::Negative;
+            // the query's own coefficient: positive for the cells of a triangulation
+            return orient(s).flip();
         }
         let mut t = *s;
         t[idx] = q;
@@ -75,5 +77,5 @@ pub(crate) fn perturbed_by<T: Copy, const N: usize>(
             return o;
         }
     }
-    unreachable!("the order holds the query, whose coefficient is never zero")
+    unreachable!("the order holds the query")
 }

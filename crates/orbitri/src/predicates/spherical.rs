@@ -178,6 +178,58 @@ pub fn in_circle(s: &[[f64; 3]; 3], q: [f64; 3], compare: impl Fn(usize, usize) 
     }
 }
 
+/// Whether `q` lies strictly beyond the plane of a face `s` of the hull, counter-clockwise
+/// seen from outside and facing the centre or not (a ghost face: the far side of a
+/// hemisphere set): [`side_of_circle`], on a tie [`in_circle`]'s perturbation with the
+/// query's coefficient minus the orientation of `s`. Where `s` and `q` lie on one plane
+/// through the centre, pulling towards the centre keeps them there; then every point `p`
+/// also moves by `η_p·(1, ζ, ζ²)`, with `η_p` far smaller than every `ε`, larger for later
+/// points, and `ζ` infinitesimal. The latest of the four points decides: moved, it changes
+/// the determinant by the first non-zero coordinate of the other three's normal. Never
+/// `Zero` for four distinct points on the sphere.
+pub fn beyond(s: &[[f64; 3]; 3], q: [f64; 3], compare: impl Fn(usize, usize) -> Sign) -> Sign {
+    match side_of_circle(&s[0], &s[1], &s[2], &q) {
+        Sign::Zero => {}
+        decided => return decided,
+    }
+    match perturbed_by(s, q, |t| orient_origin(&t[0], &t[1], &t[2]), &compare) {
+        Sign::Zero => {}
+        decided => return decided,
+    }
+    let latest = (1..4).fold(0, |m, k| {
+        if compare(k, m) == Sign::Positive {
+            k
+        } else {
+            m
+        }
+    });
+    let pts = [s[0], s[1], s[2], q];
+    let others: Vec<[f64; 3]> = (0..4).filter(|&k| k != latest).map(|k| pts[k]).collect();
+    let sign = first_normal_coordinate(&others[0], &others[1], &others[2]);
+    // moving point k by v adds (−1)^(3−k) (others' normal)·v to det[p1 − p0; p2 − p0; p3 − p0]
+    if latest % 2 == 1 {
+        sign
+    } else {
+        sign.flip()
+    }
+}
+
+/// The sign of the first non-zero coordinate of `(b − a) × (c − a)`, exactly (`Zero` only
+/// for collinear points).
+#[cold]
+fn first_normal_coordinate(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> Sign {
+    let scale = Scaled::new(a.iter().chain(b).chain(c).copied());
+    let [a, b, c] = [a, b, c].map(|p| p.map(|x| scale.int(x)));
+    let d = |p: &[num_bigint::BigInt; 3], k: usize| &p[k] - &a[k];
+    (0..3)
+        .map(|k| {
+            let (i, j) = ((k + 1) % 3, (k + 2) % 3);
+            exact::sign(&(d(&b, i) * d(&c, j) - d(&b, j) * d(&c, i)))
+        })
+        .find(|&s| s != Sign::Zero)
+        .unwrap_or(Sign::Zero)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -208,21 +260,21 @@ mod tests {
     }
 
     /// An independent evaluation: `det[b'−a'; c'−a'; q'−a']` in rationals, with each point
-    /// shrunk by `1 − ε^(4−k)` for its rank `k` (the last point pulled in the most), `ε`
-    /// small enough that the lowest non-zero order decides.
+    /// shrunk by `1 − ε^(4−k)` for its rank `k` (the last point pulled in the most), then
+    /// moved by `η^(4−k)·(1, ζ, ζ²)`, each small enough that the lowest non-zero order
+    /// decides.
     fn explicit(s: &[[f64; 3]; 3], x: [f64; 3], rank: [usize; 4]) -> Sign {
-        let eps = Q::new(BigInt::one(), BigInt::from(1u64) << 200usize);
+        let tiny = |bits: usize| Q::new(BigInt::one(), BigInt::from(1u64) << bits);
+        let (eps, eta, zeta) = (tiny(200), tiny(2000), tiny(100));
         let pts = [s[0], s[1], s[2], x];
+        let power = |base: &Q, n: usize| (0..n).fold(Q::one(), |f, _| f * base);
         let shrunk: Vec<[Q; 3]> = pts
             .iter()
             .enumerate()
             .map(|(i, p)| {
-                let mut f = Q::one();
-                for _ in rank[i]..4 {
-                    f *= &eps;
-                }
-                let l = Q::one() - f;
-                p.map(|c| &l * q(c))
+                let l = Q::one() - power(&eps, 4 - rank[i]);
+                let m = power(&eta, 4 - rank[i]);
+                std::array::from_fn(|c| &l * q(p[c]) + &m * power(&zeta, c))
             })
             .collect();
         let d = |k: usize| -> [Q; 3] { std::array::from_fn(|c| &shrunk[k][c] - &shrunk[0][c]) };
@@ -375,5 +427,62 @@ mod tests {
             }
         }
         assert!(checked > 200 && ties > 50, "{checked} tests, {ties} ties");
+    }
+
+    #[test]
+    fn ghost_sides_match_the_explicit_perturbation() {
+        // a small circle (z = 0.6), a great circle (z = 0) and a tilted plane through the
+        // centre (x = y): every face, facing the centre or not
+        let pts: Vec<[f64; 3]> = [
+            [0.8, 0.0, 0.6],
+            [0.0, 0.8, 0.6],
+            [-0.48, -0.64, 0.6],
+            [0.64, -0.48, 0.6],
+            [0.8, 0.0, 0.0],
+            [0.0, -0.8, 0.0],
+            [-0.6, 0.64, 0.0],
+            [0.36, 0.48, 0.0],
+            [-0.5, -0.25, 0.0],
+            [0.5, 0.5, 0.7],
+            [-0.4, -0.4, 0.8],
+            [0.6, 0.6, -0.5],
+            [0.125, 0.125, -0.75],
+            [0.0, 0.5, 0.6],
+        ]
+        .to_vec();
+        let (mut ties, mut flat) = (0, 0);
+        let mut r = crate::sort::SplitMix::new(17);
+        for i in 0..pts.len() {
+            for j in 0..pts.len() {
+                for k in 0..pts.len() {
+                    let ids = [i, j, k];
+                    if i == j || j == k || i == k {
+                        continue;
+                    }
+                    let s = [pts[i], pts[j], pts[k]];
+                    for l in (0..pts.len()).filter(|l| !ids.contains(l)) {
+                        let x = pts[l];
+                        let side = side_of_circle(&s[0], &s[1], &s[2], &x);
+                        // a random order of the four (the same order for either test)
+                        let key: [u64; 4] = std::array::from_fn(|_| r.next_u64());
+                        let got = beyond(&s, x, |a, b| Sign::from(key[a].cmp(&key[b])));
+                        assert_ne!(got, Sign::Zero);
+                        if side != Sign::Zero {
+                            assert_eq!(got, side);
+                            continue;
+                        }
+                        ties += 1;
+                        flat += usize::from(orient_origin(&s[0], &s[1], &s[2]) == Sign::Zero);
+                        let rank =
+                            std::array::from_fn(|u| (0..4).filter(|&v| key[v] < key[u]).count());
+                        assert_eq!(got, explicit(&s, x, rank), "{i} {j} {k} {l}");
+                    }
+                }
+            }
+        }
+        assert!(
+            ties > 100 && flat > 50,
+            "{ties} ties, {flat} through the centre"
+        );
     }
 }

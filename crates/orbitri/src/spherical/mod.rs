@@ -13,6 +13,7 @@
 //! (possible only for points off the sphere by rounding) is *hidden*: kept, reported, and a
 //! vertex again when a removal uncovers it.
 
+mod ghost;
 mod voronoi;
 
 pub use voronoi::SphericalCell;
@@ -231,12 +232,17 @@ fn check_point(index: usize, p: &[f64; 3]) -> Result<()> {
 /// The faces of a spherical triangulation ([`SphericalTriangulation::face_table`]).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct FaceTable {
-    /// Input ids, counter-clockwise seen from outside once lifted by the signs.
+    /// The (solid) faces: input ids, counter-clockwise seen from outside once lifted by
+    /// the signs.
     pub faces: Vec<[InputId; 3]>,
-    /// Per vertex, whether the face uses the antipode of its stored point.
+    /// Per vertex of a face, whether it is the antipode of its stored point.
     pub signs: Vec<[bool; 3]>,
-    /// Per edge (opposite vertex `k`), the face across, `None` beyond the faces.
-    pub neighbors: Vec<[Option<usize>; 3]>,
+    /// The ghost faces (points in a closed hemisphere), counter-clockwise seen from
+    /// outside the hull; they are numbered after the faces.
+    pub ghosts: Vec<[InputId; 3]>,
+    /// For every face, then every ghost face, the face across each edge (opposite corner
+    /// `k`) in that numbering.
+    pub neighbors: Vec<[usize; 3]>,
 }
 
 /// The Delaunay triangulation of points on the unit sphere ([`SphericalDelaunay`]), or of
@@ -621,23 +627,40 @@ impl<S: SphericalSpace> SphericalTriangulation<S> {
             .all(|&v| e.point_of(v).index() >= anchors)
     }
 
-    /// The faces with their signs and neighbours, from one pass over the cells (what
-    /// [`Self::faces`], [`Self::face_signs`] and [`Self::neighbors`] give one by one).
+    /// The faces with their signs, the ghost faces and the neighbours, from one pass over
+    /// the cells (what [`Self::faces`], [`Self::face_signs`], [`Self::ghost_faces`] and
+    /// [`Self::neighbors`] give one by one).
     pub fn face_table(&self) -> FaceTable {
         let e = &self.engine;
         let (reps, orbit) = self.face_orbits();
+        let ghosts = self.ghosts();
+        let input = |p: PointId| self.point_input[p.index()];
+        let solid = reps.len();
         let cells = || reps.iter().map(|&c| e.cell(c));
+        let mut neighbors: Vec<[usize; 3]> = cells()
+            .map(|cell| {
+                std::array::from_fn(|k| match orbit[cell.n[k].index()] {
+                    usize::MAX => {
+                        let edge = (cell.v[(k + 2) % 3], cell.v[(k + 1) % 3]);
+                        solid + ghosts.by_edge[&(e.point_of(edge.0), e.point_of(edge.1))]
+                    }
+                    f => f,
+                })
+            })
+            .collect();
+        neighbors.extend((0..ghosts.faces.len()).map(|f| {
+            std::array::from_fn(|k| match ghosts.across(f, k) {
+                Ok(g) => solid + g,
+                Err(c) => orbit[c.index()],
+            })
+        }));
         FaceTable {
             faces: cells()
-                .map(|cell| cell.v.map(|v| self.point_input[e.point_of(v).index()]))
+                .map(|cell| cell.v.map(|v| input(e.point_of(v))))
                 .collect(),
             signs: cells().map(|cell| cell.off.map(S::is_antipode)).collect(),
-            neighbors: cells()
-                .map(|cell| {
-                    cell.n
-                        .map(|d| Some(orbit[d.index()]).filter(|&k| k != usize::MAX))
-                })
-                .collect(),
+            ghosts: ghosts.faces.iter().map(|f| f.map(input)).collect(),
+            neighbors,
         }
     }
 
@@ -653,6 +676,24 @@ impl<S: SphericalSpace> SphericalTriangulation<S> {
     /// point (always false on the sphere). At most one per face is.
     pub fn face_signs(&self) -> Vec<[bool; 3]> {
         self.face_table().signs
+    }
+
+    /// CGAL's ghost faces: for points in a closed hemisphere ([`Self::covers_sphere`]
+    /// false, dimension 2), the faces of the hull that do not hold the centre strictly
+    /// inside; their empty caps are a hemisphere or more. With [`Self::faces`] they cover
+    /// the sphere. Input ids, counter-clockwise seen from outside the hull; ties (four
+    /// rim points on one plane) broken as for the faces.
+    ///
+    /// ```
+    /// use orbitri::spherical::SphericalDelaunay;
+    /// // the equator's four axis points and the north pole: the equator's square is
+    /// // flat through the centre, two ghost faces
+    /// let pts = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0]];
+    /// let tri = SphericalDelaunay::build(&pts).unwrap();
+    /// assert_eq!((tri.faces().len(), tri.ghost_faces().len()), (4, 2));
+    /// ```
+    pub fn ghost_faces(&self) -> Vec<[InputId; 3]> {
+        self.face_table().ghosts
     }
 
     /// The faces of the space (one stored cell per orbit, the copy in the quotient's
@@ -696,10 +737,10 @@ impl<S: SphericalSpace> SphericalTriangulation<S> {
         (reps, orbit)
     }
 
-    /// For each face of [`Self::faces`], the face across each edge (edge `k` is opposite
-    /// vertex `k`), `None` beyond the faces (where the hull turns its outer side to the
-    /// centre: the points lie in a hemisphere).
-    pub fn neighbors(&self) -> Vec<[Option<usize>; 3]> {
+    /// For each face of [`Self::faces`] and then each of [`Self::ghost_faces`], the face
+    /// across each edge (edge `k` is opposite vertex `k`), numbered the same way: an index
+    /// from `faces().len()` on is a ghost face.
+    pub fn neighbors(&self) -> Vec<[usize; 3]> {
         self.face_table().neighbors
     }
 

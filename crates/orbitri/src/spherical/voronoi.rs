@@ -6,9 +6,12 @@
 
 use rayon::prelude::*;
 
+use super::ghost::Ghosts;
 use super::{SphericalSpace, SphericalTriangulation};
 use crate::error::{Error, Result};
 use crate::ids::{CellId, InputId, PointId, VertexId};
+use crate::predicates::spherical::side_of_circle;
+use crate::predicates::Sign;
 use crate::space::pole;
 
 /// The Voronoi cell of one vertex on the sphere.
@@ -67,9 +70,11 @@ fn root(parent: &mut [u32], mut x: u32) -> u32 {
 
 impl<S: SphericalSpace> SphericalTriangulation<S> {
     /// The Voronoi cell of every vertex, in the order of [`Self::vertices`] (in RP², around
-    /// the stored representative of each point; the areas sum to 2π). Points in a closed
-    /// hemisphere (see [`Self::covers_sphere`]), or of dimension below 2, are
-    /// [`Error::Hemisphere`].
+    /// the stored representative of each point; the areas sum to 2π). For points in a
+    /// closed hemisphere the cells pass through the poles of the ghost faces
+    /// ([`Self::ghost_faces`]), whose empty caps are a hemisphere or more. Below dimension
+    /// 2 (at most two points, or all on one circle) there are no faces to be dual to:
+    /// [`Error::NoFaces`].
     ///
     /// ```
     /// use orbitri::spherical::SphericalDelaunay;
@@ -85,25 +90,30 @@ impl<S: SphericalSpace> SphericalTriangulation<S> {
     /// ```
     pub fn voronoi_cells(&self) -> Result<Vec<SphericalCell>> {
         let dimension = self.dimension();
-        if dimension < 2 || !self.covers_sphere() {
-            return Err(Error::Hemisphere {
+        if dimension < 2 {
+            return Err(Error::NoFaces {
                 points: self.number_of_vertices(),
                 dimension,
             });
         }
         let e = self.engine();
         let sp = e.space();
-        let ids: Vec<CellId> = e.cell_ids().collect();
+        let ghosts = self.ghosts();
+        // faces: the engine's cells (those without an anchor), then the ghost faces
+        let slots = e.cell_slots();
+        let ids: Vec<CellId> = e.cell_ids().filter(|&c| self.is_face(c)).collect();
+        let at = |p: PointId| e.points()[p.index()];
+        let ghost_at = |f: usize| ghosts.faces[f].map(at);
         // faces on one circle: one class, one pole
-        let mut parent: Vec<u32> = (0..e.cell_slots() as u32).collect();
-        let merges: Vec<(u32, u32)> = ids
+        let mut parent: Vec<u32> = (0..(slots + ghosts.faces.len()) as u32).collect();
+        let mut merges: Vec<(u32, u32)> = ids
             .par_iter()
             .flat_map_iter(|&c| {
                 let cell = e.cell(c);
                 let s = e.lifted_cell(c);
                 (0..3).filter_map(move |k| {
                     let d = cell.n[k];
-                    if d < c {
+                    if d < c || !self.is_face(d) {
                         return None;
                     }
                     let j = e.cell(d).mirror(c).expect("symmetric neighbours");
@@ -114,6 +124,24 @@ impl<S: SphericalSpace> SphericalTriangulation<S> {
                 })
             })
             .collect();
+        for f in 0..ghosts.faces.len() {
+            let [a, b, c] = ghost_at(f);
+            for k in 0..3 {
+                let (other, q) = match ghosts.across(f, k) {
+                    Ok(h) if h < f => continue,
+                    Ok(h) => (slots + h, ghosts.faces[h]),
+                    Err(d) => (d.index(), e.cell(d).v.map(|v| e.point_of(v))),
+                };
+                let edge = [ghosts.faces[f][(k + 1) % 3], ghosts.faces[f][(k + 2) % 3]];
+                let opposite = q
+                    .into_iter()
+                    .find(|p| !edge.contains(p))
+                    .expect("a triangle");
+                if side_of_circle(&a, &b, &c, &at(opposite)) == Sign::Zero {
+                    merges.push(((slots + f) as u32, other as u32));
+                }
+            }
+        }
         for (a, b) in merges {
             let (ra, rb) = (root(&mut parent, a), root(&mut parent, b));
             parent[ra.max(rb) as usize] = ra.min(rb);
@@ -121,65 +149,132 @@ impl<S: SphericalSpace> SphericalTriangulation<S> {
         for c in 0..parent.len() as u32 {
             root(&mut parent, c);
         }
-        // each cell's pole in its own frame; a class shares its root's, up to the antipode
-        // between frames (the one of the two that the cell's own pole is near)
-        let own = |c: CellId| {
-            let [a, b, d] = e.lifted_cell(c).map(|(p, g)| S::position(p, g));
+        // each face's pole in its own frame; a class shares its root's, up to the antipode
+        // between frames (the one of the two that the face's own pole is near)
+        let own = |f: usize| {
+            let [a, b, d] = if f < slots {
+                e.lifted_cell(CellId::new(f))
+                    .map(|(p, g)| S::position(p, g))
+            } else {
+                ghost_at(f - slots)
+            };
             pole(&a, &b, &d)
         };
-        let computed: Vec<(CellId, [f64; 3])> = ids
+        let faces: Vec<usize> = ids
+            .iter()
+            .map(|c| c.index())
+            .chain(slots..parent.len())
+            .collect();
+        let computed: Vec<(usize, [f64; 3])> = faces
             .par_iter()
-            .map(|&c| {
-                let mine = own(c);
-                let r = CellId(parent[c.index()]);
-                if r == c {
-                    return (c, mine);
+            .map(|&f| {
+                let mine = own(f);
+                let r = parent[f] as usize;
+                if r == f {
+                    return (f, mine);
                 }
                 let theirs = own(r);
                 let flip = dot(&mine, &theirs) < 0.0;
-                (c, theirs.map(|x| if flip { -x } else { x }))
+                (f, theirs.map(|x| if flip { -x } else { x }))
             })
             .collect();
-        let mut poles = vec![[0.0; 3]; e.cell_slots()];
-        for (c, p) in computed {
-            poles[c.index()] = p;
+        let mut poles = vec![[0.0; 3]; parent.len()];
+        for (f, p) in computed {
+            poles[f] = p;
         }
+        let star = Star {
+            tri: self,
+            ghosts: &ghosts,
+            class: &parent,
+            poles: &poles,
+        };
         let anchors = self.point_input.len() - self.number_of_vertices();
         Ok((anchors..self.point_input.len())
             .into_par_iter()
-            .map(|p| self.cell_of(e.vertex_of_point(PointId::new(p)), &parent, &poles))
+            .map(|p| star.cell_of(e.vertex_of_point(PointId::new(p))))
             .collect())
+    }
+}
+
+/// The faces around the vertices: the engine's cells, and the ghost faces where the
+/// engine has anchor cells; with each face's class and pole.
+struct Star<'a, S: SphericalSpace> {
+    tri: &'a SphericalTriangulation<S>,
+    ghosts: &'a Ghosts,
+    class: &'a [u32],
+    poles: &'a [[f64; 3]],
+}
+
+impl<S: SphericalSpace> Star<'_, S> {
+    /// Around vertex `v` from face `f` (an engine cell below the cell slots, a ghost face
+    /// above): the site across the arc to the next face counter-clockwise seen from
+    /// outside in `v`'s frame, the next face, and whether `f`'s frame is the antipode of
+    /// `v`'s (there, its turn around `v` goes the other way).
+    fn step(&self, v: VertexId, f: usize) -> (PointId, usize, bool) {
+        let e = self.tri.engine();
+        let slots = e.cell_slots();
+        if f >= slots {
+            let g = self.ghosts.faces[f - slots];
+            let p = e.point_of(v);
+            let j = g
+                .iter()
+                .position(|&x| x == p)
+                .expect("the star holds its vertex");
+            let x = g[(j + 2) % 3];
+            let next = match self.ghosts.by_edge.get(&(p, x)) {
+                Some(&h) => slots + h,
+                None => self.ghosts.rim[&(p, x)].index(),
+            };
+            return (x, next, false);
+        }
+        let c = CellId::new(f);
+        let cell = e.cell(c);
+        let i = cell.index_of(v).expect("the star holds its vertex");
+        let flip = S::is_antipode(cell.off[i]);
+        let (a, b) = if flip {
+            ((i + 2) % 3, (i + 1) % 3)
+        } else {
+            ((i + 1) % 3, (i + 2) % 3)
+        };
+        // the next face counter-clockwise shares the edge to `b`
+        let x = e.point_of(cell.v[b]);
+        let next = cell.n[a];
+        let next = if self.tri.is_face(next) {
+            next.index()
+        } else {
+            slots + self.ghosts.by_edge[&(e.point_of(v), x)]
+        };
+        (x, next, flip)
     }
 
     /// The cell of vertex `v`: the classes of the faces around it, counter-clockwise seen
     /// from outside in `v`'s frame. A face whose frame is the antipode of `v`'s is
-    /// reflected there: its pole negated, its turn around `v` the other way.
-    fn cell_of(&self, v: VertexId, class: &[u32], poles: &[[f64; 3]]) -> SphericalCell {
-        let e = self.engine();
+    /// reflected there: its pole negated.
+    fn cell_of(&self, v: VertexId) -> SphericalCell {
+        let tri = self.tri;
+        let e = tri.engine();
+        // start at a face (a rim vertex's cell may hold an anchor)
+        let mut c = e.vcell[v.index()];
+        while !tri.is_face(c) {
+            let cell = e.cell(c);
+            c = cell.n[(cell.index_of(v).expect("the star holds its vertex") + 1) % 3];
+        }
+        let start = c.index();
         // (class, the site across the arc to the next, the pole in v's frame)
         let mut ring: Vec<(u32, InputId, [f64; 3])> = Vec::new();
-        let start = e.vcell[v.index()];
-        let mut c = start;
+        let mut f = start;
         loop {
-            let cell = e.cell(c);
-            let i = cell.index_of(v).expect("the star holds its vertex");
-            let flip = S::is_antipode(cell.off[i]);
-            let (a, b) = if flip {
-                ((i + 2) % 3, (i + 1) % 3)
-            } else {
-                ((i + 1) % 3, (i + 2) % 3)
-            };
-            // the next face counter-clockwise shares the edge to `b`
-            let x = self.point_input[e.point_of(cell.v[b]).index()];
-            let k = class[c.index()];
+            let (x, next, flip) = self.step(v, f);
+            let x = tri.point_input[x.index()];
+            let k = self.class[f];
             if ring.last().map(|r| r.0) == Some(k) {
                 ring.last_mut().expect("non-empty").1 = x;
             } else {
-                let p = poles[c.index()];
+                let p = self.poles[f];
                 ring.push((k, x, if flip { p.map(|y| -y) } else { p }));
             }
-            c = cell.n[a];
-            if c == start {
+            f = next;
+            if f == start {
                 break;
             }
         }
@@ -190,11 +285,10 @@ impl<S: SphericalSpace> SphericalTriangulation<S> {
         let site = unit(e.points()[e.point_of(v).index()]);
         let vertices: Vec<[f64; 3]> = ring.iter().map(|r| r.2).collect();
         let m = vertices.len();
-        let (mut area, mut moment) = (0.0, [0.0; 3]);
+        let mut moment = [0.0; 3];
         let mut arc_lengths = Vec::with_capacity(m);
         for k in 0..m {
             let (a, b) = (&vertices[k], &vertices[(k + 1) % m]);
-            area += triangle_area(&site, a, b);
             let n = cross(a, b);
             let len = dot(&n, &n).sqrt();
             let theta = len.atan2(dot(a, b));
@@ -205,13 +299,25 @@ impl<S: SphericalSpace> SphericalTriangulation<S> {
                 }
             }
         }
+        let centroid = unit(moment);
+        // the area as a fan of triangles from the site, or from the centroid when a vertex
+        // is more than a quarter turn from the site (a long cell of a hemisphere set: the
+        // triangles' formula loses its accuracy near the antipode of their apex)
+        let apex = if vertices.iter().any(|w| dot(w, &site) < 0.0) {
+            &centroid
+        } else {
+            &site
+        };
+        let area = (0..m)
+            .map(|k| triangle_area(apex, &vertices[k], &vertices[(k + 1) % m]))
+            .sum();
         SphericalCell {
-            site: self.point_input[e.point_of(v).index()],
+            site: tri.point_input[e.point_of(v).index()],
             neighbors: ring.iter().map(|r| r.1).collect(),
             vertices,
             arc_lengths,
             area,
-            centroid: unit(moment),
+            centroid,
         }
     }
 }
