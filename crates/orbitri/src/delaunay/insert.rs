@@ -305,8 +305,15 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// hides leave the triangulation, each renumbering the last point into its id, and
     /// are logged in `hidden_log`, in order.
     pub fn insert_weighted(&mut self, p: S::Point, w: f64) -> Inserted {
+        self.insert_keyed(p, w, self.space.spatial_key(&p))
+    }
+
+    /// [`Self::insert_weighted`] for a point whose spatial key the caller has computed
+    /// already (to sort a batch): `key` must be `space().spatial_key(&p)`.
+    pub fn insert_keyed(&mut self, p: S::Point, w: f64, key: u64) -> Inserted {
+        debug_assert_eq!(key, self.space.spatial_key(&p));
         self.scratch.hidden.clear();
-        self.insert_point(p, w)
+        self.insert_point(p, w, key)
     }
 
     /// After inserting point `pi`: drops the points whose vertices it hid, largest id
@@ -345,7 +352,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         pi
     }
 
-    fn insert_point(&mut self, p: S::Point, w: f64) -> Inserted {
+    fn insert_point(&mut self, p: S::Point, w: f64, key: u64) -> Inserted {
         if self.points.is_empty() {
             self.push_point(p, w);
             self.bootstrap_covering();
@@ -353,7 +360,6 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         }
         let pi = PointId::new(self.points.len());
         if self.one_sheeted {
-            let key = self.space.spatial_key(&p);
             let from = self.insertion_start(key);
             self.push_point(p, w);
             self.vpoint.push(pi);
@@ -379,7 +385,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                             // the quotient would stop being a triangulation: continue in
                             // the covering space
                             self.rebuild_in_covering();
-                            self.insert_point(p, w)
+                            self.insert_point(p, w, key)
                         }
                     }
                 }

@@ -26,6 +26,10 @@ pub(super) struct Locator {
     slots: Vec<VertexId>,
     /// The number of points when the grid was sized: refilled at twice that.
     sized_for: usize,
+    /// The number of points a bulk build announced ([`Engine::reserve`]): the grid is
+    /// sized for them from the start, rather than refilled as they double (recomputing
+    /// every key each time: a tenth of the sphere's keys at 10⁶ points).
+    pub(super) planned: usize,
     /// The grid cell of the last insertion: the next one jumps only from another.
     last: usize,
 }
@@ -43,7 +47,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// levels of the Hilbert curve) and fills it; 1-sheeted only.
     pub(super) fn refill_locator(&mut self) {
         let dim = (N - 1) as u32;
-        let n = self.points.len();
+        let n = self.points.len().max(self.locator.planned);
         let mut bits = 0;
         while bits < S::KEY_BITS / dim && (1usize << (dim * (bits + 1))) <= n / 2 {
             bits += 1;
@@ -56,6 +60,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             slots,
             sized_for: n.max(1),
             last: usize::MAX,
+            planned: self.locator.planned,
         };
         for (i, p) in self.points.iter().enumerate() {
             let k = self.locator.slot(self.space.spatial_key(p));

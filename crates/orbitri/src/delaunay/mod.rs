@@ -315,8 +315,10 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         }
     }
 
-    /// Reserves room for about `cells` cells and `points` points (bulk construction).
+    /// Reserves room for about `cells` cells and `points` points, and sizes the
+    /// point-location grid for them (bulk construction).
     pub fn reserve(&mut self, points: usize, cells: usize) {
+        self.locator.planned = self.points.len() + points;
         self.points.reserve(points);
         self.vpoint.reserve(points);
         self.vcell.reserve(points);

@@ -170,14 +170,15 @@ fn internal_points<const D: usize, const N: usize, S: FlatSpace<D, N>>(
     Ok((out, moved))
 }
 
-/// The BRIO + Hilbert insertion order of internal points.
+/// The BRIO + Hilbert insertion order of internal points, and their spatial keys (which
+/// the engine's point location uses too).
 fn spatial_order<const D: usize, const N: usize, S: FlatSpace<D, N>>(
     space: &S,
     points: &[[f64; D]],
     seed: u64,
-) -> Vec<u32> {
+) -> (Vec<u32>, Vec<u64>) {
     let keys: Vec<u64> = points.iter().map(|p| space.spatial_key(p)).collect();
-    crate::sort::brio_order(&keys, seed)
+    (crate::sort::brio_order(&keys, seed), keys)
 }
 
 /// The indices of internal points in Hilbert order (a batch of moves or queries: each
@@ -270,10 +271,11 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         let space = empty.space().clone();
         let (wrapped_pts, wrapped) = internal_points(&space, points)?;
         let weight = |i: usize| weights.get(i).copied().unwrap_or(0.0);
-        let order: Vec<u32> = if opts.spatial_sort {
+        let (order, keys) = if opts.spatial_sort {
             spatial_order(&space, &wrapped_pts, opts.seed)
         } else {
-            (0..points.len() as u32).collect()
+            let keys = wrapped_pts.iter().map(|p| space.spatial_key(p)).collect();
+            ((0..points.len() as u32).collect(), keys)
         };
         let fresh = || {
             let mut tri = empty.emptied();
@@ -287,7 +289,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         tri.engine
             .reserve(points.len() + 128, points.len() * per_point / 4 + 4096);
         if points.len() >= opts.dummy_threshold
-            && tri.build_from_dummies(&wrapped_pts, weights, &order, &mut progress)?
+            && tri.build_from_dummies(&wrapped_pts, weights, (&order, &keys), &mut progress)?
         {
             tri.represent_first_occurrences(&wrapped_pts);
             return Ok(tri);
@@ -299,7 +301,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
                 proceed(&mut progress, k)?;
             }
             let i = i as usize;
-            tri.insert_wrapped(InputId::new(i), wrapped_pts[i], weight(i));
+            tri.insert_keyed(InputId::new(i), wrapped_pts[i], weight(i), keys[i]);
         }
         if !tri.engine.is_one_sheeted() {
             tri.engine.try_one_sheet();
@@ -340,7 +342,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         &mut self,
         pts: &[[f64; D]],
         weights: &[f64],
-        order: &[u32],
+        (order, keys): (&[u32], &[u64]),
         progress: &mut impl FnMut(usize) -> ControlFlow<()>,
     ) -> Result<bool> {
         let dummies = self.engine.space().dummy_points();
@@ -364,7 +366,10 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
                 proceed(progress, n)?;
             }
             let w = weights.get(i as usize).copied().unwrap_or(0.0);
-            match self.engine.insert_weighted(pts[i as usize], w) {
+            match self
+                .engine
+                .insert_keyed(pts[i as usize], w, keys[i as usize])
+            {
                 Inserted::New(p) => {
                     // a dummy hidden by a point on it (of a larger weight): start again
                     // without
@@ -402,7 +407,13 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     /// Inserts input `i` at the internal point `p` of internal weight `w` (ignored when
     /// unweighted).
     fn insert_wrapped(&mut self, i: InputId, p: [f64; D], w: f64) -> Inserted {
-        let r = self.engine.insert_weighted(p, w);
+        let key = self.space().spatial_key(&p);
+        self.insert_keyed(i, p, w, key)
+    }
+
+    /// [`Self::insert_wrapped`] with the point's spatial key computed already.
+    fn insert_keyed(&mut self, i: InputId, p: [f64; D], w: f64, key: u64) -> Inserted {
+        let r = self.engine.insert_keyed(p, w, key);
         match r {
             Inserted::New(v) => self.record_new(i, v),
             Inserted::Duplicate(v) => self.record_duplicate(i, v),
@@ -459,11 +470,12 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             .resize(first + internal.len(), PointId::NONE);
         let seed = BuildOptions::default().seed ^ first as u64;
         let mut out = vec![Inserted::New(PointId(0)); internal.len()];
-        for k in spatial_order(self.space(), internal, seed) {
+        let (order, keys) = spatial_order(self.space(), internal, seed);
+        for k in order {
             let k = k as usize;
             let i = InputId::new(first + k);
             let w = weights.get(k).copied().unwrap_or(0.0);
-            out[k] = self.insert_wrapped(i, internal[k], w);
+            out[k] = self.insert_keyed(i, internal[k], w, keys[k]);
         }
         // a duplicate inserted before its first occurrence lent the point its coordinates;
         // (hidden points, and points a later one hid, have no point)
