@@ -1021,6 +1021,11 @@ class Voronoi:
     give the faces, ``cells()`` the cells whole, ``to_dataframe()`` the table and ``plot()``
     a picture (2D).
 
+    The measures are computed at once (about a third of the memory of the whole cells at
+    10⁶ points); the faces and cells on first use, from the same triangulation: once it has
+    changed (an ``insert``, ``remove`` or ``move``), they are a ``ValueError`` asking for a
+    new ``voronoi()`` rather than the cells of another triangulation.
+
     >>> import numpy as np, orbitri
     >>> vor = orbitri.periodic_voronoi(np.random.default_rng(4).random((200, 2)), [1.0, 1.0])
     >>> vor
@@ -1029,7 +1034,7 @@ class Voronoi:
 
     def __init__(self, core, tri: _Delaunay):
         self._v = core
-        # the triangulation as it is now: a later insert does not change these cells
+        # the triangulation as it is now: a later insert does not change these measures
         self._points = tri.points
         self._first = tri.duplicates
         self._lattice = tri.lattice if isinstance(tri, PeriodicDelaunay) else None

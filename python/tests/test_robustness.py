@@ -241,6 +241,24 @@ def test_ctrl_c_stops_the_voronoi_cells():
     assert tri.number_of_input_points == 200_001
 
 
+def test_voronoi_cells_of_a_changed_triangulation_are_an_error_not_stale():
+    rng = np.random.default_rng(18)
+    tri = orbitri.PeriodicDelaunay(rng.random((200, 3)), [1.0, 1.0, 1.0])
+    vor = tri.voronoi()
+    before = vor.volumes.copy()
+    first = vor.cells()  # computed on first use, from the same triangulation
+    assert len(first) == 200 and abs(sum(c["volume"] for c in first) - 1.0) < 1e-12
+    late = tri.voronoi()
+    tri.insert(rng.random((5, 3)))
+    # the measures stay those of the triangulation measured
+    assert np.array_equal(vor.volumes, before) and len(vor) == 200
+    assert len(vor.cells()) == 200  # computed before the change: kept
+    with pytest.raises(ValueError, match="changed since voronoi"):
+        late.neighbors()
+    fresh = tri.voronoi()
+    assert len(fresh.cells()) == 205 and abs(fresh.volumes.sum() - 1.0) < 1e-12
+
+
 def test_every_scale_gives_the_same_simplices_and_scaled_volumes():
     rng = np.random.default_rng(4)
     pts = np.floor(rng.random((300, 3)) * 2**20) / 2**20

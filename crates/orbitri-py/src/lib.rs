@@ -19,7 +19,7 @@
 
 use std::ops::ControlFlow;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
-use std::sync::{mpsc, Arc, Mutex, RwLock, RwLockReadGuard, RwLockWriteGuard};
+use std::sync::{mpsc, Arc, Mutex, OnceLock, RwLock, RwLockReadGuard, RwLockWriteGuard};
 use std::time::Duration;
 
 use numpy::ndarray::{Array1, Array2, Array3, ArrayD, ArrayView2, IxDyn};
@@ -280,8 +280,49 @@ struct Triangulation {
     tri: Arc<RwLock<Tri>>,
     /// 2 or 3 (never changes: read without the lock).
     dim: usize,
-    /// Counts the modifications of the cells (for the Python side's cache of `cells()`).
-    generation: AtomicU64,
+    /// Counts the modifications of the cells (for the Python side's cache of `cells()`,
+    /// and a `Voronoi`'s check that its triangulation is still the one it measured).
+    generation: Arc<AtomicU64>,
+    /// (last: runs once the triangulation is dropped)
+    release: Release,
+}
+
+impl Drop for Triangulation {
+    fn drop(&mut self) {
+        // (a `Voronoi` still sharing the triangulation releases it later)
+        self.release.large = Arc::strong_count(&self.tri) == 1
+            && self
+                .tri
+                .read()
+                .is_ok_and(|t| with_tri!(&*t, t => t.number_of_input_points()) >= Release::LARGE);
+    }
+}
+
+/// Gives the memory that dropping a large triangulation or Voronoi diagram freed back to
+/// the system. glibc keeps freed memory in its arenas, one per thread that allocated (the
+/// build and the cells allocate from every worker), so that a Python process would keep
+/// the peak of a computation after `del`: 0.5 GB of 0.6 at 2·10⁵ points. The last field
+/// of its owner, so that it runs after the others are dropped; the owner's `Drop` arms it.
+#[derive(Default)]
+struct Release {
+    large: bool,
+}
+
+impl Release {
+    /// Points from which a drop is worth the trim (a walk over the arenas).
+    const LARGE: usize = 1 << 16;
+}
+
+impl Drop for Release {
+    fn drop(&mut self) {
+        #[cfg(all(target_os = "linux", target_env = "gnu"))]
+        if self.large {
+            // SAFETY: `malloc_trim` only returns free memory to the system.
+            unsafe {
+                libc::malloc_trim(0);
+            }
+        }
+    }
 }
 
 fn poisoned<T>(_: T) -> PyErr {
@@ -295,7 +336,8 @@ impl Triangulation {
         Triangulation {
             tri: Arc::new(RwLock::new(tri)),
             dim,
-            generation: AtomicU64::new(0),
+            generation: Arc::new(AtomicU64::new(0)),
+            release: Release::default(),
         }
     }
 
@@ -553,7 +595,6 @@ fn cells_of<const D: usize, const N: usize, S: Served<D, N>>(
 ) -> PyResult<CellsOf<D, N, S>> {
     Ok(CellsOf {
         cells: t.voronoi_cells_until(interrupt).map_err(value_error)?,
-        first: t.first_occurrences(),
         space: t.space().clone(),
     })
 }
@@ -891,37 +932,46 @@ impl Triangulation {
         Ok(with_tri!(&*guard, t => vertex_neighbors(py, t, i)))
     }
 
-    /// The Voronoi cells of the points (computed without holding the interpreter; Ctrl-C
-    /// stops them).
+    /// The Voronoi cells of the points: their measures now (computed without holding the
+    /// interpreter; Ctrl-C stops them), the cells themselves on first use.
     fn voronoi(&self, py: Python<'_>) -> PyResult<Voronoi> {
         let (vertices, total) = with_tri!(&*self.read(py)?, t => {
             t.space().check_volume_representable().map_err(value_error)?;
             (t.number_of_vertices(), t.voronoi_polls())
         });
         let shared = Arc::clone(&self.tri);
+        let generation = Arc::clone(&self.generation);
         // each poll follows about the same work: one unit of progress
-        let cells = interruptible(py, vertices, ("Voronoi cells", total), move |control| {
-            let interrupt = || {
-                control.done.fetch_add(1, Ordering::Relaxed);
-                control.stopped()
-            };
-            Ok(match &*shared.read().map_err(poisoned)? {
-                Tri::Two(t) => Cells::Two(cells_of(t, &interrupt)?),
-                Tri::Three(t) => Cells::Three(cells_of(t, &interrupt)?),
-                Tri::Klein(t) => Cells::Klein(cells_of(t, &interrupt)?),
-                Tri::Manifold3(t) => Cells::Manifold3(cells_of(t, &interrupt)?),
-            })
-        })?;
-        let per_point = with_cells!(&cells, c => PerPoint::of(c));
-        Ok(Voronoi { cells, per_point })
+        let (per_point, cells, at) =
+            interruptible(py, vertices, ("Voronoi cells", total), move |control| {
+                let interrupt = || {
+                    control.done.fetch_add(1, Ordering::Relaxed);
+                    control.stopped()
+                };
+                let guard = shared.read().map_err(poisoned)?;
+                let at = generation.load(Ordering::Acquire);
+                let (per_point, cells) = with_tri!(&*guard, t => {
+                    let m = t.voronoi_measures_until(&interrupt).map_err(value_error)?;
+                    (PerPoint::of(&m, &t.first_occurrences()), m.len())
+                });
+                Ok((per_point, cells, at))
+            })?;
+        Ok(Voronoi {
+            per_point,
+            cells,
+            tri: Arc::clone(&self.tri),
+            generation: Arc::clone(&self.generation),
+            at,
+            geometry: OnceLock::new(),
+            release: Release::default(),
+        })
     }
 }
 
-/// The Voronoi cells of the distinct points (sorted by input id), every input point's first
-/// occurrence, and the space (for the elements' inverses).
+/// The Voronoi cells of the distinct points (sorted by input id), and the space (for the
+/// elements' inverses).
 struct CellsOf<const D: usize, const N: usize, S: Served<D, N>> {
     cells: Vec<VoronoiCell<D, S::Elem>>,
-    first: Vec<InputId>,
     space: S,
 }
 
@@ -934,15 +984,6 @@ enum Cells {
 }
 
 impl<const D: usize, const N: usize, S: Served<D, N>> CellsOf<D, N, S> {
-    /// The cell of every input point (a duplicate's is its first occurrence's; none for a
-    /// removed input).
-    fn per_input(&self) -> Vec<Option<usize>> {
-        self.first
-            .iter()
-            .map(|f| self.cells.binary_search_by_key(f, |c| c.point).ok())
-            .collect()
-    }
-
     /// (pairs E×2, elements, areas E): each pair of neighbouring images once.
     fn neighbors(&self, py: Python<'_>) -> (Py<PyAny>, Py<PyAny>, Py<PyAny>) {
         let pairs = orbitri::voronoi::neighbor_pairs_by(&self.cells, |g| {
@@ -1006,8 +1047,10 @@ struct PerPoint {
 }
 
 impl PerPoint {
-    fn of<const D: usize, const N: usize, S: Served<D, N>>(c: &CellsOf<D, N, S>) -> Self {
-        // a removed input's measures are NaN (and -1 faces)
+    /// Per input, from the measures of the distinct points (sorted by input id) and every
+    /// input's first occurrence: a duplicate gets its first occurrence's, a removed input
+    /// NaN (and −1 faces).
+    fn of<const D: usize>(measures: &[CellMeasures<D>], first: &[InputId]) -> Self {
         let gone = CellMeasures {
             point: InputId::NONE,
             volume: f64::NAN,
@@ -1015,10 +1058,13 @@ impl PerPoint {
             surface_area: f64::NAN,
             centroid: [f64::NAN; D],
         };
-        let m: Vec<CellMeasures<D>> = c
-            .per_input()
-            .into_iter()
-            .map(|k| k.map_or(gone, |k| CellMeasures::from(&c.cells[k])))
+        let m: Vec<CellMeasures<D>> = first
+            .iter()
+            .map(|f| {
+                measures
+                    .binary_search_by_key(f, |c| c.point)
+                    .map_or(gone, |k| measures[k])
+            })
             .collect();
         PerPoint {
             volumes: m.iter().map(|x| x.volume).collect(),
@@ -1041,10 +1087,66 @@ impl PerPoint {
 
 /// The Voronoi cells of a triangulation (use `PeriodicDelaunay.voronoi()` or
 /// `Triangulation.voronoi()`).
+///
+/// The measures are computed at once; the cells' geometry (`cells()`, `neighbors()`) on
+/// first use, from the same triangulation: it is an error once the triangulation has
+/// changed (rather than the cells of another triangulation, or a copy of every cell kept
+/// in case: three times the memory of the measures at 10⁶ points).
 #[pyclass(module = "orbitri._orbitri")]
 struct Voronoi {
-    cells: Cells,
     per_point: PerPoint,
+    /// Number of distinct cells.
+    cells: usize,
+    tri: Arc<RwLock<Tri>>,
+    generation: Arc<AtomicU64>,
+    /// The triangulation's generation when measured.
+    at: u64,
+    geometry: OnceLock<Cells>,
+    /// (last: runs once the cells, and the triangulation if no one else holds it, are
+    /// dropped)
+    release: Release,
+}
+
+impl Drop for Voronoi {
+    fn drop(&mut self) {
+        self.release.large = self.cells >= Release::LARGE;
+    }
+}
+
+impl Voronoi {
+    /// The cells' geometry, computed on first use; an error once the triangulation changed.
+    fn geometry(&self, py: Python<'_>) -> PyResult<&Cells> {
+        if let Some(c) = self.geometry.get() {
+            return Ok(c);
+        }
+        let shared = Arc::clone(&self.tri);
+        let generation = Arc::clone(&self.generation);
+        let at = self.at;
+        let total =
+            with_tri!(&*self.tri.read_py_attached(py).map_err(poisoned)?, t => t.voronoi_polls());
+        let cells = interruptible(py, self.cells, ("Voronoi cells", total), move |control| {
+            let interrupt = || {
+                control.done.fetch_add(1, Ordering::Relaxed);
+                control.stopped()
+            };
+            let guard = shared.read().map_err(poisoned)?;
+            if generation.load(Ordering::Acquire) != at {
+                return Err(PyValueError::new_err(
+                    "the triangulation has changed since voronoi() measured it: call voronoi() \
+                     again for the cells and neighbours of the triangulation as it is now",
+                ));
+            }
+            Ok(match &*guard {
+                Tri::Two(t) => Cells::Two(cells_of(t, &interrupt)?),
+                Tri::Three(t) => Cells::Three(cells_of(t, &interrupt)?),
+                Tri::Klein(t) => Cells::Klein(cells_of(t, &interrupt)?),
+                Tri::Manifold3(t) => Cells::Manifold3(cells_of(t, &interrupt)?),
+            })
+        })?;
+        // (another thread may have set it meanwhile: the same cells)
+        let _ = self.geometry.set(cells);
+        Ok(self.geometry.get().expect("just set"))
+    }
 }
 
 #[pymethods]
@@ -1076,18 +1178,18 @@ impl Voronoi {
 
     /// (pairs E×2, elements, areas E): each pair of neighbouring images once; a torus's
     /// elements are shifts (E×D), a manifold's (cosets E, offsets E×D).
-    fn neighbors(&self, py: Python<'_>) -> (Py<PyAny>, Py<PyAny>, Py<PyAny>) {
-        with_cells!(&self.cells, c => c.neighbors(py))
+    fn neighbors(&self, py: Python<'_>) -> PyResult<(Py<PyAny>, Py<PyAny>, Py<PyAny>)> {
+        Ok(with_cells!(self.geometry(py)?, c => c.neighbors(py)))
     }
 
     /// Every distinct point's cell as a dict: id, position, volume, centroid, vertices
     /// (K×D) and faces (dicts of vertices, neighbor, shift or element, area).
     fn cells<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
-        with_cells!(&self.cells, c => c.dicts(py))
+        with_cells!(self.geometry(py)?, c => c.dicts(py))
     }
 
     fn __len__(&self) -> usize {
-        with_cells!(&self.cells, c => c.cells.len())
+        self.cells
     }
 }
 
