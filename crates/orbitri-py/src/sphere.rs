@@ -20,7 +20,7 @@ use pyo3::prelude::*;
 use pyo3::sync::RwLockExt;
 use pyo3::types::PyDict;
 
-use super::{array2, id_error, input_ids, interruptible, poisoned, value_error};
+use super::{array2, id_error, input_ids, interruptible, poisoned, value_error, Release};
 
 /// The rows of an `(N, K)` array as points of `K` coordinates, or the error naming the
 /// expected shape.
@@ -97,6 +97,18 @@ pub(super) struct PySpherical {
     tri: Arc<RwLock<Spherical>>,
     /// Counts the modifications (for the Python side's cache of the faces).
     generation: AtomicU64,
+    /// (last: runs once the triangulation is dropped)
+    release: Release,
+}
+
+impl Drop for PySpherical {
+    fn drop(&mut self) {
+        self.release.large = Arc::strong_count(&self.tri) == 1
+            && self
+                .tri
+                .read()
+                .is_ok_and(|t| with_s!(&*t, t => t.number_of_input_points()) >= Release::LARGE);
+    }
 }
 
 impl PySpherical {
@@ -160,6 +172,7 @@ impl PySpherical {
         Ok(PySpherical {
             tri: Arc::new(RwLock::new(tri)),
             generation: AtomicU64::new(0),
+            release: Release::default(),
         })
     }
 
@@ -337,6 +350,7 @@ impl PySpherical {
                     cells,
                     first: first_occurrences(t),
                     hidden,
+                    release: Release::default(),
                 })
             })
         })
@@ -351,6 +365,14 @@ pub(super) struct SphericalVoronoi {
     first: Vec<Option<InputId>>,
     /// The hidden inputs.
     hidden: Vec<usize>,
+    /// (last: runs once the cells are dropped)
+    release: Release,
+}
+
+impl Drop for SphericalVoronoi {
+    fn drop(&mut self) {
+        self.release.large = self.cells.len() >= Release::LARGE;
+    }
 }
 
 impl SphericalVoronoi {
