@@ -102,16 +102,45 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
-/// Newell's normal of a polygon (twice its vector area).
-fn newell(pts: &[&[f64]]) -> [f64; 3] {
+/// Newell's normal of the polygon `vertices[ids]` (twice its vector area; 3D).
+fn newell<const D: usize>(vertices: &[[f64; D]], ids: &[u32]) -> [f64; 3] {
     let mut n = [0.0; 3];
-    for k in 0..pts.len() {
-        let c = cross(pts[k], pts[(k + 1) % pts.len()]);
+    for k in 0..ids.len() {
+        let a = &vertices[ids[k] as usize];
+        let b = &vertices[ids[(k + 1) % ids.len()] as usize];
+        let c = cross(&a[..], &b[..]);
         for (nc, cc) in n.iter_mut().zip(c) {
             *nc += cc;
         }
     }
     n
+}
+
+/// The buffers of [`Triangulation::cell_of_point`], reused from cell to cell by one worker
+/// (a cell needed some sixty small allocations: a tenth of the Voronoi pass in malloc).
+pub(crate) struct CellScratch<E> {
+    parent: Vec<usize>,
+    vertex_of_root: Vec<u32>,
+    vertex_of: Vec<u32>,
+    edges: Vec<(VertexId, E)>,
+    member: Vec<(u32, u32)>,
+    ring: Vec<usize>,
+    cycle: Vec<usize>,
+}
+
+// (not derived: that would ask the group elements for a `Default`)
+impl<E> Default for CellScratch<E> {
+    fn default() -> Self {
+        CellScratch {
+            parent: Vec::new(),
+            vertex_of_root: Vec::new(),
+            vertex_of: Vec::new(),
+            edges: Vec::new(),
+            member: Vec::new(),
+            ring: Vec::new(),
+            cycle: Vec::new(),
+        }
+    }
 }
 
 /// Union–find root with path halving.
@@ -147,7 +176,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             return self.hidden_cell(i);
         }
         let duals = self.duals(&|| false).expect("never interrupted");
-        self.cell_of_point(&duals, self.vertex_of_input(i))
+        self.cell_of_point(&duals, self.vertex_of_input(i), &mut CellScratch::default())
     }
 
     /// The Voronoi cells of the distinct points, in the order of their first occurrence
@@ -223,11 +252,11 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         let duals = self.duals(interrupt)?;
         let mut out: Vec<Option<T>> = (0..self.number_of_vertices() as u32)
             .into_par_iter()
-            .map(|p| {
+            .map_init(CellScratch::default, |scratch, p| {
                 if p % POINTS_PER_POLL as u32 == 0 && interrupt() {
                     return Err(Error::Interrupted);
                 }
-                Ok(Some(f(self.cell_of_point(&duals, PointId(p)))))
+                Ok(Some(f(self.cell_of_point(&duals, PointId(p), scratch))))
             })
             .collect::<Result<_>>()?;
         // the points, then the hidden inputs (empty cells), by input id
@@ -370,7 +399,21 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     }
 
     /// The cell of point `p`, from the cells around one of its vertices.
-    fn cell_of_point(&self, duals: &Duals<D>, p: PointId) -> VoronoiCell<D, S::Elem> {
+    fn cell_of_point(
+        &self,
+        duals: &Duals<D>,
+        p: PointId,
+        scratch: &mut CellScratch<S::Elem>,
+    ) -> VoronoiCell<D, S::Elem> {
+        let CellScratch {
+            parent,
+            vertex_of_root,
+            vertex_of,
+            edges,
+            member,
+            ring,
+            cycle,
+        } = scratch;
         let e = self.engine();
         let space = self.space();
         let v = e.vertex_of_point(p).index();
@@ -379,7 +422,8 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         // one Voronoi vertex per group of star cells joined, through facets at the point, by
         // a shared circumsphere (so in one lift around the point: a sphere met again around
         // the torus at another lift of the point is another vertex)
-        let mut parent: Vec<usize> = (0..star.len()).collect();
+        parent.clear();
+        parent.extend(0..star.len());
         for (s, &(c, k)) in star.iter().enumerate() {
             let cell = e.cell(c);
             for x in
@@ -390,31 +434,31 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
                     .iter()
                     .position(|&(sc, _)| sc == d)
                     .expect("a neighbour across a facet at the point is in its star");
-                let (a, b) = (root(&mut parent, s), root(&mut parent, t));
+                let (a, b) = (root(parent, s), root(parent, t));
                 parent[a.max(b)] = a.min(b);
             }
         }
         let mut vertices: Vec<[f64; D]> = Vec::with_capacity(star.len());
-        let mut vertex_of_root = vec![u32::MAX; star.len()];
-        let vertex_of: Vec<u32> = (0..star.len())
-            .map(|s| {
-                let r = root(&mut parent, s);
-                if vertex_of_root[r] == u32::MAX {
-                    let (c, k) = star[r];
-                    // the center is relative to the cell's vertex 0, in the cell's frame;
-                    // the point's own frame is that of its element in the cell
-                    let at = e.lifted(c, k as usize);
-                    let to_point = space.lifted_difference(at, e.lifted(c, 0));
-                    let z = duals.center[c.index()];
-                    vertices.push(space.untwist(at.1, std::array::from_fn(|x| z[x] - to_point[x])));
-                    vertex_of_root[r] = vertices.len() as u32 - 1;
-                }
-                vertex_of_root[r]
-            })
-            .collect();
+        vertex_of_root.clear();
+        vertex_of_root.resize(star.len(), u32::MAX);
+        vertex_of.clear();
+        vertex_of.extend((0..star.len()).map(|s| {
+            let r = root(parent, s);
+            if vertex_of_root[r] == u32::MAX {
+                let (c, k) = star[r];
+                // the center is relative to the cell's vertex 0, in the cell's frame;
+                // the point's own frame is that of its element in the cell
+                let at = e.lifted(c, k as usize);
+                let to_point = space.lifted_difference(at, e.lifted(c, 0));
+                let z = duals.center[c.index()];
+                vertices.push(space.untwist(at.1, std::array::from_fn(|x| z[x] - to_point[x])));
+                vertex_of_root[r] = vertices.len() as u32 - 1;
+            }
+            vertex_of_root[r]
+        }));
         // faces: the ring of star cells around each Delaunay edge at the point
-        let mut edges: Vec<(VertexId, S::Elem)> = Vec::new();
-        let mut member: Vec<(u32, u32)> = Vec::with_capacity(star.len() * (N - 1));
+        edges.clear();
+        member.clear();
         for (s, &(c, k)) in star.iter().enumerate() {
             let cell = e.cell(c);
             for j in (0..N).filter(|&j| j != k as usize) {
@@ -428,10 +472,11 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         }
         member.sort_unstable();
         let mut faces = Vec::with_capacity(edges.len());
-        for (f, ring) in member.chunk_by(|a, b| a.0 == b.0).enumerate() {
+        for (f, members) in member.chunk_by(|a, b| a.0 == b.0).enumerate() {
             let (w, r) = edges[f];
-            let ring: Vec<usize> = ring.iter().map(|m| m.1 as usize).collect();
-            let cycle = self.ring_cycle(star, &ring, w, r);
+            ring.clear();
+            ring.extend(members.iter().map(|m| m.1 as usize));
+            self.ring_cycle(star, ring, (w, r), cycle);
             let mut ids: Vec<u32> = cycle.iter().map(|&s| vertex_of[s]).collect();
             ids.dedup();
             while ids.len() > 1 && ids.first() == ids.last() {
@@ -442,9 +487,9 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             }
             let wp = e.points()[e.point_of(w).index()];
             let dir = space.lifted_difference((wp, r), (position, space.identity()));
-            let pts: Vec<&[f64]> = ids.iter().map(|&i| &vertices[i as usize][..]).collect();
             let area = if D == 2 {
-                let d: Vec<f64> = (0..2).map(|x| pts[1][x] - pts[0][x]).collect();
+                let (a, b) = (&vertices[ids[0] as usize], &vertices[ids[1] as usize]);
+                let d: [f64; 2] = std::array::from_fn(|x| b[x] - a[x]);
                 // counter-clockwise around the cell: the outward normal (d_y, −d_x) points
                 // to the neighbour
                 if d[1] * dir[0] - d[0] * dir[1] < 0.0 {
@@ -452,7 +497,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
                 }
                 dot(&d, &d).sqrt()
             } else {
-                let n = newell(&pts);
+                let n = newell(&vertices, &ids);
                 if dot(&n, &dir) < 0.0 {
                     ids.reverse();
                 }
@@ -492,11 +537,12 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         &self,
         star: &[(CellId, u8)],
         ring: &[usize],
-        w: VertexId,
-        r: S::Elem,
-    ) -> Vec<usize> {
+        (w, r): (VertexId, S::Elem),
+        cycle: &mut Vec<usize>,
+    ) {
         let e = self.engine();
-        let mut cycle = vec![ring[0]];
+        cycle.clear();
+        cycle.push(ring[0]);
         let mut prev = CellId::NONE;
         loop {
             let (c, k) = star[*cycle.last().unwrap()];
@@ -518,7 +564,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
                 .find(|&s| star[s].0 == next)
                 .expect("the ring is closed");
             if s == cycle[0] {
-                return cycle;
+                return;
             }
             prev = c;
             cycle.push(s);
@@ -537,21 +583,21 @@ fn measure<const D: usize, E>(
     let mut vol = 0.0;
     let mut acc = [0.0; D];
     for f in faces {
-        let v: Vec<&[f64; D]> = f.vertices.iter().map(|&i| &vertices[i as usize]).collect();
+        let v = |k: usize| &vertices[f.vertices[k] as usize];
         if D == 2 {
             // the edge runs counter-clockwise: the signed triangles from the point sum to
             // the area even when the point lies outside its cell (a power cell)
-            let a = (v[0][0] * v[1][1] - v[0][1] * v[1][0]) / 2.0;
+            let a = (v(0)[0] * v(1)[1] - v(0)[1] * v(1)[0]) / 2.0;
             vol += a;
             for c in 0..D {
-                acc[c] += a * (v[0][c] + v[1][c]) / 3.0;
+                acc[c] += a * (v(0)[c] + v(1)[c]) / 3.0;
             }
         } else {
-            for t in 1..v.len() - 1 {
-                let t6 = dot(&v[0][..], &cross(&v[t][..], &v[t + 1][..])) / 6.0;
+            for t in 1..f.vertices.len() - 1 {
+                let t6 = dot(&v(0)[..], &cross(&v(t)[..], &v(t + 1)[..])) / 6.0;
                 vol += t6;
                 for c in 0..D {
-                    acc[c] += t6 * (v[0][c] + v[t][c] + v[t + 1][c]) / 4.0;
+                    acc[c] += t6 * (v(0)[c] + v(t)[c] + v(t + 1)[c]) / 4.0;
                 }
             }
         }
