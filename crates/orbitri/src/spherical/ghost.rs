@@ -125,11 +125,12 @@ fn gift_wrap(open: Vec<(PointId, PointId)>, at: impl Fn(PointId) -> [f64; 3]) ->
     let mut ring: Vec<PointId> = open.iter().flat_map(|&(a, b)| [a, b]).collect();
     ring.sort_unstable();
     ring.dedup();
+    // a disk bounded by `b` edges, no vertex inside: `b − 2` faces (a bound on the loop)
+    let bound = open.len();
     let mut stack = open;
     stack.sort_unstable();
     let mut pending: HashSet<(PointId, PointId)> = stack.iter().copied().collect();
     let mut faces = Vec::new();
-    // a disk bounded by k vertices, none inside: k − 2 faces
     while let Some((u, w)) = stack.pop() {
         if !pending.remove(&(u, w)) {
             continue;
@@ -148,7 +149,7 @@ fn gift_wrap(open: Vec<(PointId, PointId)>, at: impl Fn(PointId) -> [f64; 3]) ->
         }
         let Some((c, _)) = best else { break };
         faces.push([u, w, c]);
-        if faces.len() + 2 > ring.len() {
+        if faces.len() > bound {
             break;
         }
         for (x, y) in [(w, c), (c, u)] {
