@@ -58,6 +58,12 @@ impl Control {
     fn stopped(&self) -> bool {
         self.stop.load(Ordering::Relaxed)
     }
+
+    /// Counts one unit of progress, and says whether to stop (the Voronoi passes' poll).
+    fn poll(&self) -> bool {
+        self.done.fetch_add(1, Ordering::Relaxed);
+        self.stopped()
+    }
 }
 
 /// The Python callable shown the progress of long computations (`set_progress_hook`):
@@ -289,12 +295,8 @@ struct Triangulation {
 
 impl Drop for Triangulation {
     fn drop(&mut self) {
-        // (a `Voronoi` still sharing the triangulation releases it later)
-        self.release.large = Arc::strong_count(&self.tri) == 1
-            && self
-                .tri
-                .read()
-                .is_ok_and(|t| with_tri!(&*t, t => t.number_of_input_points()) >= Release::LARGE);
+        self.release
+            .arm_if_last(&self.tri, |t| with_tri!(t, t => t.number_of_input_points()));
     }
 }
 
@@ -311,6 +313,13 @@ struct Release {
 impl Release {
     /// Points from which a drop is worth the trim (a walk over the arenas).
     const LARGE: usize = 1 << 16;
+
+    /// Arms the release for an owner of a shared triangulation of `points(t)` points, if
+    /// the owner holds the last reference (a `Voronoi` still sharing it releases it later).
+    fn arm_if_last<T>(&mut self, shared: &Arc<RwLock<T>>, points: impl Fn(&T) -> usize) {
+        self.large = Arc::strong_count(shared) == 1
+            && shared.read().is_ok_and(|t| points(&t) >= Self::LARGE);
+    }
 }
 
 impl Drop for Release {
@@ -944,10 +953,7 @@ impl Triangulation {
         // each poll follows about the same work: one unit of progress
         let (per_point, cells, at) =
             interruptible(py, vertices, ("Voronoi cells", total), move |control| {
-                let interrupt = || {
-                    control.done.fetch_add(1, Ordering::Relaxed);
-                    control.stopped()
-                };
+                let interrupt = || control.poll();
                 let guard = shared.read().map_err(poisoned)?;
                 let at = generation.load(Ordering::Acquire);
                 let (per_point, cells) = with_tri!(&*guard, t => {
@@ -1125,10 +1131,7 @@ impl Voronoi {
         let total =
             with_tri!(&*self.tri.read_py_attached(py).map_err(poisoned)?, t => t.voronoi_polls());
         let cells = interruptible(py, self.cells, ("Voronoi cells", total), move |control| {
-            let interrupt = || {
-                control.done.fetch_add(1, Ordering::Relaxed);
-                control.stopped()
-            };
+            let interrupt = || control.poll();
             let guard = shared.read().map_err(poisoned)?;
             if generation.load(Ordering::Acquire) != at {
                 return Err(PyValueError::new_err(

@@ -103,11 +103,8 @@ pub(super) struct PySpherical {
 
 impl Drop for PySpherical {
     fn drop(&mut self) {
-        self.release.large = Arc::strong_count(&self.tri) == 1
-            && self
-                .tri
-                .read()
-                .is_ok_and(|t| with_s!(&*t, t => t.number_of_input_points()) >= Release::LARGE);
+        self.release
+            .arm_if_last(&self.tri, |t| with_s!(t, t => t.number_of_input_points()));
     }
 }
 

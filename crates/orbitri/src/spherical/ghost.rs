@@ -47,7 +47,8 @@ impl<S: SphericalSpace> SphericalTriangulation<S> {
     pub(super) fn ghosts(&self) -> Ghosts {
         let e = &self.engine;
         let mut g = Ghosts::default();
-        if S::ANTIPODAL || self.dimension() < 2 || self.covers_sphere() {
+        // (the dimension, a scan of every point, last)
+        if S::ANTIPODAL || self.covers_sphere() || self.dimension() < 2 {
             return g;
         }
         for c in e.cell_ids().filter(|&c| self.is_face(c)) {

@@ -199,6 +199,20 @@ pub type SphericalDelaunay = SphericalTriangulation<Sphere>;
 /// ([`SphericalTriangulation::face_signs`]).
 pub type ProjectiveDelaunay = SphericalTriangulation<ProjectivePlane>;
 
+/// The stored representatives of `points` with their spatial keys, by index, in BRIO +
+/// Hilbert order; gathered in that order before the insertion loop (independent loads
+/// overlap, where a load inside the loop stalls it: a tenth of the build at 10⁶ points).
+fn insertion_order<S: SphericalSpace>(points: &[[f64; 3]], seed: u64) -> Vec<(u32, [f64; 3], u64)> {
+    let keys: Vec<u64> = points
+        .par_iter()
+        .map(|&p| sphere_key(&S::representative(p)))
+        .collect();
+    crate::sort::brio_order(&keys, seed)
+        .into_iter()
+        .map(|i| (i, S::representative(points[i as usize]), keys[i as usize]))
+        .collect()
+}
+
 /// The space with the first anchor set that none of `points` meets.
 fn anchors_for<S: SphericalSpace>(points: &[[f64; 3]]) -> S {
     (0..)
@@ -335,17 +349,7 @@ impl<S: SphericalSpace> SphericalTriangulation<S> {
         let mut tri = Self::with_space(anchors_for::<S>(points));
         tri.engine.reserve(points.len() + 4, 2 * points.len() + 8);
         tri.input_point = vec![PointId::NONE; points.len()];
-        let keys: Vec<u64> = points
-            .par_iter()
-            .map(|&p| sphere_key(&S::representative(p)))
-            .collect();
-        // gathered in insertion order first: independent loads overlap, where a load inside
-        // the insertion loop stalls it (a tenth of the build at 10⁶ points)
-        let sorted: Vec<(u32, [f64; 3], u64)> = crate::sort::brio_order(&keys, 0x0b17)
-            .into_iter()
-            .map(|i| (i, S::representative(points[i as usize]), keys[i as usize]))
-            .collect();
-        for (k, &(i, p, key)) in sorted.iter().enumerate() {
+        for (k, (i, p, key)) in insertion_order::<S>(points, 0x0b17).into_iter().enumerate() {
             if k % 4096 == 0 && progress(k).is_break() {
                 return Err(Error::Interrupted);
             }
@@ -380,11 +384,8 @@ impl<S: SphericalSpace> SphericalTriangulation<S> {
             self.reanchor(points);
         }
         self.input_point.resize(first + points.len(), PointId::NONE);
-        let stored: Vec<[f64; 3]> = points.iter().map(|&p| S::representative(p)).collect();
-        let keys: Vec<u64> = stored.iter().map(sphere_key).collect();
-        for k in crate::sort::brio_order(&keys, 0x0b17 ^ first as u64) {
-            let k = k as usize;
-            self.insert_stored(InputId::new(first + k), stored[k], keys[k]);
+        for (k, p, key) in insertion_order::<S>(points, 0x0b17 ^ first as u64) {
+            self.insert_stored(InputId::new(first + k as usize), p, key);
         }
         // (statuses as they are now: a later point may have hidden an earlier one)
         Ok((first..first + points.len())
