@@ -5,11 +5,7 @@
 #
 # usage: bench/voronoi.sh [REPS] [N ...]     default: 3 reps, N = 100000 1000000
 set -euo pipefail
-root=$(cd "$(dirname "$0")/.." && pwd)
-out=$root/bench/out
-mkdir -p "$out"
-cargo build --release -q -p orbitri-cli --manifest-path "$root/Cargo.toml"
-orb=$root/target/release/orbitri
+. "$(dirname "$0")/setup.sh"
 reps=${1:-3}
 shift || true
 ns=${*:-100000 1000000}

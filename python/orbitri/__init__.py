@@ -828,6 +828,11 @@ class PeriodicDelaunay(_Delaunay):
     >>> orbitri.PeriodicDelaunay([[0.1, 0.2, 0.0], [0.6, 0.7, 0.0]], [1.0, 1.0]).dimension
     2
 
+    ``threads=N`` builds in parallel rounds on N threads (and runs the construction's other
+    steps on N threads); every N gives the same triangulation, stored the same, so every
+    array is the same. The default, ``None``, inserts the points one at a time, which is the
+    fastest on one or two cores (see the README).
+
     Weighted points (atoms or grains of given radii): ``weights=`` (squared lengths) or
     ``radii=`` give the regular triangulation, whose ``voronoi()`` cells are the power
     (Laguerre, radical) cells; a point whose power cell is empty is ``hidden``:
@@ -838,12 +843,12 @@ class PeriodicDelaunay(_Delaunay):
     ([2], 1.0)
     """
 
-    def __init__(self, points, box=None, weights=None, radii=None):
+    def __init__(self, points, box=None, weights=None, radii=None, threads=None):
         if box is None:
             points, box = _system(points)
         p = _points(points, _box(box)[1])
         w = _weights(weights, radii, len(p))
-        super().__init__(_Triangulation(p, lattice_matrix(box, p.shape[1]), w))
+        super().__init__(_Triangulation(p, lattice_matrix(box, p.shape[1]), w, threads))
 
     def __repr__(self) -> str:
         return f"<orbitri.PeriodicDelaunay: {self._describe()}, box {Box(self.lattice)!r}>"
@@ -965,14 +970,16 @@ class Triangulation(_Delaunay):
     True
     """
 
-    def __init__(self, points, space: FlatManifold):
+    def __init__(self, points, space: FlatManifold, threads=None):
         if not isinstance(space, FlatManifold):
             raise TypeError(
                 f"space must be a FlatManifold or a KleinBottle, not {type(space).__name__} "
                 f"(for a periodic box use PeriodicDelaunay)"
             )
         self.space = space
-        super().__init__(_Triangulation.in_manifold(_points(points, space.dimension), space._space))
+        super().__init__(
+            _Triangulation.in_manifold(_points(points, space.dimension), space._space, threads)
+        )
 
     def __repr__(self) -> str:
         return f"<orbitri.Triangulation: {self._describe()}, space {self.space!r}>"
@@ -995,7 +1002,7 @@ class Triangulation(_Delaunay):
         return vertices, elements, (int(coset), offset)
 
 
-def periodic_voronoi(points, box=None, weights=None, radii=None) -> "Voronoi":
+def periodic_voronoi(points, box=None, weights=None, radii=None, threads=None) -> "Voronoi":
     """The periodic Voronoi cells of points in a box: ``PeriodicDelaunay(points,
     box).voronoi()``; ``periodic_voronoi(system)`` takes an ASE ``Atoms``, an MDAnalysis
     ``Universe`` or ``AtomGroup``, or freud's ``(box, points)``. With ``weights=`` or
@@ -1010,7 +1017,7 @@ def periodic_voronoi(points, box=None, weights=None, radii=None) -> "Voronoi":
     >>> round(float(orbitri.periodic_voronoi((box, points)).volumes.sum()), 6)
     1000.0
     """
-    return PeriodicDelaunay(points, box, weights=weights, radii=radii).voronoi()
+    return PeriodicDelaunay(points, box, weights=weights, radii=radii, threads=threads).voronoi()
 
 
 class Voronoi:

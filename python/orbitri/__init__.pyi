@@ -125,7 +125,12 @@ class _Delaunay:
 
 class PeriodicDelaunay(_Delaunay):
     def __init__(
-        self, points: Any, box: Any = None, weights: npt.ArrayLike | None = None, radii: npt.ArrayLike | None = None
+        self,
+        points: Any,
+        box: Any = None,
+        weights: npt.ArrayLike | None = None,
+        radii: npt.ArrayLike | None = None,
+        threads: int | None = None,
     ) -> None: ...
     @property
     def lattice(self) -> _Floats: ...
@@ -161,7 +166,7 @@ class KleinBottle(FlatManifold):
 
 class Triangulation(_Delaunay):
     space: FlatManifold
-    def __init__(self, points: npt.ArrayLike, space: FlatManifold) -> None: ...
+    def __init__(self, points: npt.ArrayLike, space: FlatManifold, threads: int | None = None) -> None: ...
     @property
     def elements(self) -> tuple[_Ints, _Ints]: ...
     def elements_as_isometries(self) -> tuple[_Floats, _Floats]: ...
@@ -174,7 +179,11 @@ class Triangulation(_Delaunay):
     ) -> tuple[npt.NDArray[np.int64], tuple[_Ints, _Ints]]: ...
 
 def periodic_voronoi(
-    points: Any, box: Any = None, weights: npt.ArrayLike | None = None, radii: npt.ArrayLike | None = None
+    points: Any,
+    box: Any = None,
+    weights: npt.ArrayLike | None = None,
+    radii: npt.ArrayLike | None = None,
+    threads: int | None = None,
 ) -> Voronoi: ...
 
 class SphericalDelaunay:
@@ -183,6 +192,7 @@ class SphericalDelaunay:
         points: npt.ArrayLike | None = None,
         lonlat: npt.ArrayLike | None = None,
         normalize: bool = False,
+        threads: int | None = None,
     ) -> None: ...
     @property
     def simplices(self) -> npt.NDArray[np.int64]: ...

@@ -40,14 +40,18 @@ class Space:
 
 class Triangulation:
     def __init__(
-        self, points: npt.ArrayLike, lattice: npt.ArrayLike, weights: npt.ArrayLike | None = None
+        self,
+        points: npt.ArrayLike,
+        lattice: npt.ArrayLike,
+        weights: npt.ArrayLike | None = None,
+        threads: int | None = None,
     ) -> None: ...
     @property
     def weights(self) -> npt.NDArray[np.float64] | None: ...
     @property
     def hidden(self) -> npt.NDArray[np.int64]: ...
     @staticmethod
-    def in_manifold(points: npt.ArrayLike, space: Space) -> Triangulation: ...
+    def in_manifold(points: npt.ArrayLike, space: Space, threads: int | None = None) -> Triangulation: ...
     @property
     def dimension(self) -> int: ...
     @property
@@ -124,7 +128,11 @@ class SphericalTriangulation:
     """The Delaunay triangulation of points on the unit sphere or of the projective plane
     (use ``orbitri.SphericalDelaunay``, ``orbitri.ProjectivePlane``)."""
     def __init__(
-        self, points: npt.ArrayLike, lonlat: bool = False, projective: bool = False
+        self,
+        points: npt.ArrayLike,
+        lonlat: bool = False,
+        projective: bool = False,
+        threads: int | None = None,
     ) -> None: ...
     @property
     def generation(self) -> int: ...

@@ -25,7 +25,8 @@ class SphericalDelaunay:
     ``normalize=True`` to project any non-zero vectors), or ``lonlat`` as longitudes and
     latitudes in degrees (N × 2). A point met again is a duplicate of its first occurrence;
     a point strictly inside the hull of the others (only possible off the sphere by
-    rounding) is ``hidden``; none is lost.
+    rounding) is ``hidden``; none is lost. ``threads=N`` builds in parallel rounds on N
+    threads, with the same result for every N (default: one point at a time).
 
     >>> import numpy as np, orbitri
     >>> p = np.random.default_rng(2).normal(size=(1000, 3))
@@ -43,18 +44,21 @@ class SphericalDelaunay:
 
     _projective = False
 
-    def __init__(self, points=None, lonlat=None, normalize: bool = False):
+    def __init__(self, points=None, lonlat=None, normalize: bool = False, threads=None):
         if (points is None) == (lonlat is None):
             raise TypeError("give either points (N × 3) or lonlat (N × 2)")
         if lonlat is not None:
             self._tri = _SphericalTriangulation(
-                np.asarray(lonlat, dtype=float), lonlat=True, projective=self._projective
+                np.asarray(lonlat, dtype=float),
+                lonlat=True,
+                projective=self._projective,
+                threads=threads,
             )
         else:
             p = np.asarray(points, dtype=float)
             if normalize:
                 p = self._normalized(p)
-            self._tri = _SphericalTriangulation(p, projective=self._projective)
+            self._tri = _SphericalTriangulation(p, projective=self._projective, threads=threads)
         self._faces = None
 
     @staticmethod

@@ -260,3 +260,29 @@ def test_round_trip_equals_the_command_line(tmp_path):
         assert (sheets, v, c) == (tri.sheets, 800, len(tri.simplices))
         cli = _canonical(rows[:, :n], rows[:, n:].reshape(-1, n, dim))
         assert cli == _canonical(tri.simplices, tri.offsets)
+
+
+def test_every_thread_count_gives_the_same_arrays():
+    rng = np.random.default_rng(8)
+    pts3 = rng.random((6000, 3))
+    sph = rng.normal(size=(6000, 3))
+    sph /= np.linalg.norm(sph, axis=1)[:, None]
+
+    def flat(threads):
+        tri = orbitri.PeriodicDelaunay(pts3, [1.0, 1.0, 1.0], threads=threads)
+        return tri.simplices, tri.offsets, tri.neighbors, tri.voronoi().volumes
+
+    def sphere(threads):
+        tri = orbitri.SphericalDelaunay(sph, threads=threads)
+        return tri.simplices, tri.neighbors, tri.voronoi().areas
+
+    for build in (flat, sphere):
+        one = build(1)
+        for threads in (2, 3):
+            for a, b in zip(one, build(threads)):
+                assert np.array_equal(a, b)
+    # one at a time (the default): the same simplices, stored in another order
+    canonical = lambda s: sorted(map(tuple, np.sort(s, axis=1)))
+    assert canonical(orbitri.SphericalDelaunay(sph).simplices) == canonical(sphere(2)[0])
+    with pytest.raises(ValueError, match="threads must be at least 1"):
+        orbitri.PeriodicDelaunay(pts3, [1.0, 1.0, 1.0], threads=0)

@@ -16,6 +16,14 @@ use orbitri::io::{Drawable, SpaceFormat, SvgOptions};
 use orbitri::sort::SplitMix;
 use orbitri::{BuildOptions, FlatManifold, FlatSpace, FlatTorus2, FlatTorus3, Triangulation};
 
+/// The threads that `--threads` asked for.
+static THREADS: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
+
+/// The threads of the parallel construction: `--threads`, else none (one by one).
+fn threads() -> Option<usize> {
+    THREADS.get().copied()
+}
+
 #[derive(Parser)]
 #[command(
     name = "orbitri",
@@ -25,6 +33,11 @@ use orbitri::{BuildOptions, FlatManifold, FlatSpace, FlatTorus2, FlatTorus3, Tri
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// Build the triangulation in parallel rounds on N threads, and compute the cells on N
+    /// threads (default: the triangulation one point at a time, the cells on all cores).
+    /// Every file written is the same whatever N.
+    #[arg(long, global = true, value_name = "N", value_parser = clap::value_parser!(u16).range(1..))]
+    threads: Option<u16>,
 }
 
 #[derive(Subcommand)]
@@ -488,7 +501,10 @@ fn build<const D: usize, const N: usize, S: FlatSpace<D, N>>(
         }
         std::ops::ControlFlow::Continue(())
     };
-    let opts = BuildOptions::default();
+    let opts = BuildOptions {
+        threads: threads(),
+        ..BuildOptions::default()
+    };
     let tri = match weights {
         Some(w) => Triangulation::build_weighted_with(space, pts, w, opts, progress)?,
         None => Triangulation::build_with(space, pts, opts, progress)?,
@@ -982,6 +998,13 @@ fn number(s: &str) -> Result<f64, String> {
 
 fn main() -> ExitCode {
     let cli = Cli::parse_from(mark_negative_numbers(std::env::args_os()));
+    if let Some(n) = cli.threads {
+        let _ = THREADS.set(n.into());
+        // (the first pool of the process: it cannot exist yet)
+        let _ = rayon::ThreadPoolBuilder::new()
+            .num_threads(n.into())
+            .build_global();
+    }
     let result = match cli.command {
         Command::Triangulate {
             input,

@@ -49,7 +49,7 @@ fn build<S: SphericalSpace>(
 ) -> Result<(SphericalTriangulation<S>, super::Cost), CliError> {
     let bar = progress_bar(pts.len(), pts.len(), "triangulation");
     let start = Instant::now();
-    let tri = SphericalTriangulation::build_with(pts, |k| {
+    let tri = SphericalTriangulation::build_with_threads(pts, super::threads(), |k| {
         if let Some(b) = &bar {
             b.set_position(k as u64);
         }

@@ -1496,3 +1496,52 @@ fn the_projective_plane_from_the_command_line() {
     let o = rp("draw", &["-o", &path("d.svg")]);
     assert!(o.status.success(), "{}", stderr(&o));
 }
+
+#[test]
+fn every_thread_count_writes_the_same_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let cube = write(dir.path(), "cube.txt", &random_text(6000));
+    // directions in a cube's corner, projected onto the sphere (`--normalize`)
+    let sphere = write(
+        dir.path(),
+        "sphere.txt",
+        &random_text(6000).replace(", ", " "),
+    );
+    let run = |threads: &str| -> Vec<Vec<u8>> {
+        let runs: [(&str, &Path, &[&str], &str); 4] = [
+            ("triangulate", &cube, &["--box", "1", "1", "1"], "cells"),
+            ("voronoi", &cube, &["--box", "1", "1", "1"], "csv"),
+            (
+                "triangulate",
+                &sphere,
+                &["--space", "sphere", "--normalize"],
+                "json",
+            ),
+            (
+                "voronoi",
+                &sphere,
+                &["--space", "sphere", "--normalize"],
+                "csv",
+            ),
+        ];
+        runs.iter()
+            .enumerate()
+            .map(|(k, (command, input, extra, format))| {
+                let o = dir.path().join(format!("{k}.{threads}.{format}"));
+                let mut args = vec![*command, input.to_str().unwrap()];
+                args.extend_from_slice(extra);
+                args.extend_from_slice(&["--threads", threads, "-o", o.to_str().unwrap()]);
+                let r = orbitri(&args);
+                assert!(r.status.success(), "{args:?}: {}", stderr(&r));
+                std::fs::read(o).unwrap()
+            })
+            .collect()
+    };
+    let one = run("1");
+    assert!(one.iter().all(|f| f.len() > 1000));
+    for threads in ["2", "3"] {
+        assert!(run(threads) == one, "--threads {threads} wrote other files");
+    }
+    let o = triangulate_cube(&cube, &["--threads", "0"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+}

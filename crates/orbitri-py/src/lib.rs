@@ -365,8 +365,26 @@ fn build<const D: usize, const N: usize, S: Served<D, N>>(
     py: Python<'_>,
     points: Vec<[f64; D]>,
     space: S,
+    threads: Option<usize>,
 ) -> PyResult<Tri_<D, N, S>> {
-    build_weighted(py, points, None, space)
+    build_weighted(py, points, None, space, threads)
+}
+
+/// Runs `work` on a pool of `threads` threads, or on rayon's global pool (all cores) for
+/// `None`.
+fn in_pool<T: Send>(
+    threads: Option<usize>,
+    work: impl FnOnce() -> PyResult<T> + Send,
+) -> PyResult<T> {
+    match threads {
+        None => work(),
+        Some(0) => Err(PyValueError::new_err("threads must be at least 1")),
+        Some(n) => rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build()
+            .map_err(|e| PyRuntimeError::new_err(format!("cannot start {n} threads: {e}")))?
+            .install(work),
+    }
 }
 
 /// [`build`] with weights (one per point) when given: the regular triangulation.
@@ -375,23 +393,29 @@ fn build_weighted<const D: usize, const N: usize, S: Served<D, N>>(
     points: Vec<[f64; D]>,
     weights: Option<Vec<f64>>,
     space: S,
+    threads: Option<usize>,
 ) -> PyResult<Tri_<D, N, S>> {
     let total = points.len() as u64;
     interruptible(py, points.len(), ("triangulating", total), move |control| {
-        let progress = |k: usize| {
-            control.done.store(k as u64, Ordering::Relaxed);
-            if control.stopped() {
-                ControlFlow::Break(())
-            } else {
-                ControlFlow::Continue(())
+        in_pool(threads, || {
+            let progress = |k: usize| {
+                control.done.store(k as u64, Ordering::Relaxed);
+                if control.stopped() {
+                    ControlFlow::Break(())
+                } else {
+                    ControlFlow::Continue(())
+                }
+            };
+            let opts = BuildOptions {
+                threads,
+                ..BuildOptions::default()
+            };
+            match weights {
+                Some(w) => Tri_::build_weighted_with(space, &points, &w, opts, progress),
+                None => Tri_::build_with(space, &points, opts, progress),
             }
-        };
-        let opts = BuildOptions::default();
-        match weights {
-            Some(w) => Tri_::build_weighted_with(space, &points, &w, opts, progress),
-            None => Tri_::build_with(space, &points, opts, progress),
-        }
-        .map_err(value_error)
+            .map_err(value_error)
+        })
     })
 }
 
@@ -628,12 +652,13 @@ impl Triangulation {
     /// The triangulation of a flat torus given by its lattice (rows); with `weights` (one
     /// per point, squared lengths) the regular triangulation.
     #[new]
-    #[pyo3(signature = (points, lattice, weights=None))]
+    #[pyo3(signature = (points, lattice, weights=None, threads=None))]
     fn new(
         py: Python<'_>,
         points: PyArrayLike2<'_, f64, AllowTypeChange>,
         lattice: PyArrayLike2<'_, f64, AllowTypeChange>,
         weights: Option<PyArrayLike1<'_, f64, AllowTypeChange>>,
+        threads: Option<usize>,
     ) -> PyResult<Self> {
         let p = points.as_array();
         let l = lattice.as_array();
@@ -646,8 +671,8 @@ impl Triangulation {
             )));
         }
         let tri = match d {
-            2 => Tri::Two(build_weighted(py, rows(p), w, torus(l)?)?),
-            3 => Tri::Three(build_weighted(py, rows(p), w, torus(l)?)?),
+            2 => Tri::Two(build_weighted(py, rows(p), w, torus(l)?, threads)?),
+            3 => Tri::Three(build_weighted(py, rows(p), w, torus(l)?, threads)?),
             _ => {
                 return Err(PyValueError::new_err(format!(
                     "points must have 2 or 3 columns, not {d}"
@@ -659,10 +684,12 @@ impl Triangulation {
 
     /// The triangulation of a closed flat manifold (a Klein bottle, a flat 3-manifold).
     #[staticmethod]
+    #[pyo3(signature = (points, space, threads=None))]
     fn in_manifold(
         py: Python<'_>,
         points: PyArrayLike2<'_, f64, AllowTypeChange>,
         space: &Space,
+        threads: Option<usize>,
     ) -> PyResult<Self> {
         let p = points.as_array();
         let d = space.dimension();
@@ -674,8 +701,8 @@ impl Triangulation {
             )));
         }
         let tri = match &space.m {
-            Manifold::Two(m) => Tri::Klein(build(py, rows(p), m.clone())?),
-            Manifold::Three(m) => Tri::Manifold3(build(py, rows(p), m.clone())?),
+            Manifold::Two(m) => Tri::Klein(build(py, rows(p), m.clone(), threads)?),
+            Manifold::Three(m) => Tri::Manifold3(build(py, rows(p), m.clone(), threads)?),
         };
         Ok(Self::of(tri, d))
     }

@@ -20,7 +20,7 @@ use pyo3::prelude::*;
 use pyo3::sync::RwLockExt;
 use pyo3::types::PyDict;
 
-use super::{array2, id_error, input_ids, interruptible, poisoned, value_error, Release};
+use super::{array2, id_error, in_pool, input_ids, interruptible, poisoned, value_error, Release};
 
 /// The rows of an `(N, K)` array as points of `K` coordinates, or the error naming the
 /// expected shape.
@@ -72,21 +72,24 @@ macro_rules! with_s {
 fn build<S: SphericalSpace>(
     py: Python<'_>,
     pts: Vec<[f64; 3]>,
+    threads: Option<usize>,
 ) -> PyResult<SphericalTriangulation<S>>
 where
     SphericalTriangulation<S>: Send,
 {
     let total = pts.len() as u64;
     interruptible(py, pts.len(), ("triangulating", total), move |control| {
-        SphericalTriangulation::<S>::build_with(&pts, |k| {
-            control.done.store(k as u64, Ordering::Relaxed);
-            if control.stopped() {
-                ControlFlow::Break(())
-            } else {
-                ControlFlow::Continue(())
-            }
+        in_pool(threads, || {
+            SphericalTriangulation::<S>::build_with_threads(&pts, threads, |k| {
+                control.done.store(k as u64, Ordering::Relaxed);
+                if control.stopped() {
+                    ControlFlow::Break(())
+                } else {
+                    ControlFlow::Continue(())
+                }
+            })
+            .map_err(value_error)
         })
-        .map_err(value_error)
     })
 }
 
@@ -153,18 +156,19 @@ impl PySpherical {
     /// Triangulates `points`: unit vectors `(N, 3)` or, with `lonlat`, longitudes and
     /// latitudes in degrees `(N, 2)`; on the projective plane with `projective`.
     #[new]
-    #[pyo3(signature = (points, lonlat = false, projective = false))]
+    #[pyo3(signature = (points, lonlat = false, projective = false, threads = None))]
     fn new(
         py: Python<'_>,
         points: PyArrayLike2<'_, f64, AllowTypeChange>,
         lonlat: bool,
         projective: bool,
+        threads: Option<usize>,
     ) -> PyResult<Self> {
         let pts = unit_vectors(&points, lonlat)?;
         let tri = if projective {
-            Spherical::Projective(build(py, pts)?)
+            Spherical::Projective(build(py, pts, threads)?)
         } else {
-            Spherical::Sphere(build(py, pts)?)
+            Spherical::Sphere(build(py, pts, threads)?)
         };
         Ok(PySpherical {
             tri: Arc::new(RwLock::new(tri)),

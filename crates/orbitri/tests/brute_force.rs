@@ -90,6 +90,7 @@ fn insertion_order_does_not_matter() {
                 seed: trial,
                 spatial_sort: trial != 1,
                 dummy_threshold: if trial == 2 { usize::MAX } else { 1000 },
+                ..BuildOptions::default()
             };
             let tri = PeriodicDelaunay3::build_with(space.clone(), &shuffled, opts, |_| {
                 std::ops::ControlFlow::Continue(())

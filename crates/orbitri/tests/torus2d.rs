@@ -406,6 +406,7 @@ fn insertion_order_and_construction_path_do_not_matter() {
                 dummy_threshold: threshold,
                 seed,
                 spatial_sort: sort,
+                ..BuildOptions::default()
             };
             let tri = PeriodicDelaunay2::build_with(torus.clone(), &pts, opts, |_| {
                 std::ops::ControlFlow::Continue(())

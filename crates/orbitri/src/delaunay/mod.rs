@@ -9,6 +9,7 @@
 mod covering;
 mod insert;
 mod locator;
+mod parallel;
 mod remove;
 mod validate;
 mod wrap;
@@ -19,6 +20,7 @@ use crate::sort::SplitMix;
 use crate::space::{Lifted, OrbitSpace};
 use crate::tds::{Cell, Tds};
 
+pub use parallel::{Item, Log};
 pub use remove::{Moved, Removal};
 pub use validate::Invalid;
 
@@ -131,6 +133,8 @@ pub struct Engine<S: OrbitSpace<N>, const N: usize> {
     scratch: Scratch<S::Elem>,
     /// Jump-and-walk grid of the 1-sheeted triangulation.
     locator: locator::Locator,
+    /// Threads of the parallel bulk insertion (0: one by one).
+    threads: usize,
 }
 
 impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
@@ -160,6 +164,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             rng: SplitMix::new(0x5eed),
             scratch: Scratch::default(),
             locator: locator::Locator::default(),
+            threads: 0,
         };
         e.clear();
         e

@@ -23,7 +23,7 @@ use std::collections::BTreeMap;
 use rayon::prelude::*;
 use std::ops::ControlFlow;
 
-use crate::delaunay::{Engine, Inserted, Invalid};
+use crate::delaunay::{Engine, Inserted, Invalid, Item};
 use crate::error::{Error, Result};
 use crate::ids::{CellId, InputId, PointId};
 use crate::predicates::spherical::{orient_origin, side_of_circle};
@@ -202,14 +202,21 @@ pub type ProjectiveDelaunay = SphericalTriangulation<ProjectivePlane>;
 /// The stored representatives of `points` with their spatial keys, by index, in BRIO +
 /// Hilbert order; gathered in that order before the insertion loop (independent loads
 /// overlap, where a load inside the loop stalls it: a tenth of the build at 10⁶ points).
-fn insertion_order<S: SphericalSpace>(points: &[[f64; 3]], seed: u64) -> Vec<(u32, [f64; 3], u64)> {
+fn insertion_order<S: SphericalSpace>(
+    points: &[[f64; 3]],
+    seed: u64,
+    first: usize,
+) -> Vec<Item<[f64; 3]>> {
     let keys: Vec<u64> = points
         .par_iter()
         .map(|&p| sphere_key(&S::representative(p)))
         .collect();
     crate::sort::brio_order(&keys, seed)
-        .into_iter()
-        .map(|i| (i, S::representative(points[i as usize]), keys[i as usize]))
+        .into_par_iter()
+        .map(|i| {
+            let p = S::representative(points[i as usize]);
+            ((first + i as usize) as u32, p, 0.0, keys[i as usize])
+        })
         .collect()
 }
 
@@ -333,6 +340,17 @@ impl<S: SphericalSpace> SphericalTriangulation<S> {
     /// stops the construction with [`Error::Interrupted`].
     pub fn build_with(
         points: &[[f64; 3]],
+        progress: impl FnMut(usize) -> ControlFlow<()>,
+    ) -> Result<Self> {
+        Self::build_with_threads(points, None, progress)
+    }
+
+    /// [`Self::build_with`] inserting in parallel rounds on `threads` threads (the
+    /// triangulation is stored the same, slot for slot, whatever their number; so are the
+    /// later batches of [`Self::insert_all`]); `None`: one by one.
+    pub fn build_with_threads(
+        points: &[[f64; 3]],
+        threads: Option<usize>,
         mut progress: impl FnMut(usize) -> ControlFlow<()>,
     ) -> Result<Self> {
         if points.is_empty() {
@@ -347,14 +365,10 @@ impl<S: SphericalSpace> SphericalTriangulation<S> {
             return Err(e);
         }
         let mut tri = Self::with_space(anchors_for::<S>(points));
+        tri.engine.set_threads(threads);
         tri.engine.reserve(points.len() + 4, 2 * points.len() + 8);
         tri.input_point = vec![PointId::NONE; points.len()];
-        for (k, (i, p, key)) in insertion_order::<S>(points, 0x0b17).into_iter().enumerate() {
-            if k % 4096 == 0 && progress(k).is_break() {
-                return Err(Error::Interrupted);
-            }
-            tri.insert_stored(InputId(i), p, key);
-        }
+        tri.insert_items(&insertion_order::<S>(points, 0x0b17, 0), &mut progress)?;
         if progress(points.len()).is_break() {
             return Err(Error::Interrupted);
         }
@@ -384,9 +398,10 @@ impl<S: SphericalSpace> SphericalTriangulation<S> {
             self.reanchor(points);
         }
         self.input_point.resize(first + points.len(), PointId::NONE);
-        for (k, p, key) in insertion_order::<S>(points, 0x0b17 ^ first as u64) {
-            self.insert_stored(InputId::new(first + k as usize), p, key);
-        }
+        let items = insertion_order::<S>(points, 0x0b17 ^ first as u64, first);
+        let unstoppable = &mut |_| ControlFlow::Continue(());
+        self.insert_items(&items, unstoppable)
+            .expect("no progress callback to stop it");
         // (statuses as they are now: a later point may have hidden an earlier one)
         Ok((first..first + points.len())
             .map(|i| self.status(InputId::new(i)).expect("just inserted"))
@@ -407,7 +422,9 @@ impl<S: SphericalSpace> SphericalTriangulation<S> {
             .collect();
         let space = anchors_for::<S>(&all);
         let n = self.input_point.len();
+        let threads = self.engine.threads();
         *self = Self::with_space(space);
+        self.engine.set_threads(threads);
         self.input_point = vec![PointId::NONE; n];
         for (i, p) in live {
             self.insert_checked(i, p);
@@ -422,7 +439,32 @@ impl<S: SphericalSpace> SphericalTriangulation<S> {
 
     /// [`Self::insert_checked`] of a stored representative and its spatial key.
     fn insert_stored(&mut self, i: InputId, p: [f64; 3], key: u64) -> Status {
-        match self.engine.insert_keyed(p, 0.0, key) {
+        let r = self.engine.insert_keyed(p, 0.0, key);
+        self.record(i, p, r)
+    }
+
+    /// Inserts `items` (tagged with their input ids) by the engine's parallel insertion,
+    /// and records each in the engine's order; `Err` if `progress` stopped it.
+    fn insert_items(
+        &mut self,
+        items: &[Item<[f64; 3]>],
+        progress: &mut impl FnMut(usize) -> ControlFlow<()>,
+    ) -> Result<()> {
+        let (log, flow) = self.engine.insert_parallel(items, &mut *progress);
+        if flow.is_break() {
+            return Err(Error::Interrupted);
+        }
+        for (k, r, hid) in log.iter() {
+            self.engine.hidden_log.extend_from_slice(hid);
+            let (i, p, _, _) = items[k as usize];
+            self.record(InputId(i), p, r);
+        }
+        Ok(())
+    }
+
+    /// Records what became of input `i` at the stored representative `p`.
+    fn record(&mut self, i: InputId, p: [f64; 3], r: Inserted) -> Status {
+        match r {
             Inserted::New(q) => {
                 // the new point came last, then the points it hid left, the last point
                 // taking each one's id: followed here in the same order

@@ -14,7 +14,7 @@ use std::ops::ControlFlow;
 
 use rayon::prelude::*;
 
-use crate::delaunay::{Engine, Inserted, Invalid, Moved, Removal};
+use crate::delaunay::{Engine, HiddenPoint, Inserted, Invalid, Item, Moved, Removal};
 use crate::error::{Error, Result};
 use crate::ids::{CellId, InputId, PointId, VertexId};
 use crate::space::{FlatManifold, FlatSpace, FlatTorus, OrbitSpace};
@@ -83,6 +83,9 @@ pub struct BuildOptions {
     pub seed: u64,
     /// Sort the points spatially (BRIO + Hilbert); otherwise insert in input order.
     pub spatial_sort: bool,
+    /// Insert in parallel rounds on this many threads (the triangulation is stored the
+    /// same, slot for slot, whatever their number); `None`: one by one.
+    pub threads: Option<usize>,
 }
 
 impl Default for BuildOptions {
@@ -91,6 +94,7 @@ impl Default for BuildOptions {
             dummy_threshold: 1000,
             seed: 0x0b17,
             spatial_sort: true,
+            threads: None,
         }
     }
 }
@@ -181,6 +185,24 @@ fn spatial_order<const D: usize, const N: usize, S: FlatSpace<D, N>>(
     (crate::sort::brio_order(&keys, seed), keys)
 }
 
+/// The engine's items of internal points in insertion `order`: tagged with their input ids
+/// (`first` + index), with their weights (none: unweighted) and spatial keys.
+fn items<const D: usize>(
+    points: &[[f64; D]],
+    weights: &[f64],
+    (order, keys): (&[u32], &[u64]),
+    first: usize,
+) -> Vec<Item<[f64; D]>> {
+    order
+        .par_iter()
+        .map(|&k| {
+            let k = k as usize;
+            let w = weights.get(k).copied().unwrap_or(0.0);
+            ((first + k) as u32, points[k], w, keys[k])
+        })
+        .collect()
+}
+
 /// The indices of internal points in Hilbert order (a batch of moves or queries: each
 /// next one near the previous).
 fn hilbert_order<const D: usize, const N: usize, S: FlatSpace<D, N>>(
@@ -230,9 +252,10 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     /// (or if removing a dummy would break the criterion) insert into the covering space.
     ///
     /// `progress` is called with the number of points inserted so far: before the first,
-    /// every 4096 points and at the end. Returning [`ControlFlow::Break`] stops the
-    /// construction, which then returns [`Error::Interrupted`] (a cancellation hook: keep
-    /// the callback cheap, it runs between insertions).
+    /// every 4096 points (65 536 with threads) and at the end. Returning
+    /// [`ControlFlow::Break`] stops the construction, which then returns
+    /// [`Error::Interrupted`] (a cancellation hook: keep the callback cheap, it runs between
+    /// insertions).
     ///
     /// ```
     /// use std::ops::ControlFlow;
@@ -270,7 +293,6 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         }
         let space = empty.space().clone();
         let (wrapped_pts, wrapped) = internal_points(&space, points)?;
-        let weight = |i: usize| weights.get(i).copied().unwrap_or(0.0);
         let (order, keys) = if opts.spatial_sort {
             spatial_order(&space, &wrapped_pts, opts.seed)
         } else {
@@ -283,6 +305,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             tri
         };
         let mut tri = fresh();
+        tri.engine.set_threads(opts.threads);
         // a Delaunay triangulation of uniform points has about 6.77 cells per vertex in 3D,
         // exactly 2 in 2D
         let per_point = if D == 3 { 27 } else { 8 };
@@ -295,14 +318,10 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             return Ok(tri);
         }
         let mut tri = fresh();
+        tri.engine.set_threads(opts.threads);
         tri.input_point = vec![PointId::NONE; points.len()];
-        for (k, &i) in order.iter().enumerate() {
-            if k % 4096 == 0 {
-                proceed(&mut progress, k)?;
-            }
-            let i = i as usize;
-            tri.insert_keyed(InputId::new(i), wrapped_pts[i], weight(i), keys[i]);
-        }
+        let items = items(&wrapped_pts, weights, (&order, &keys), 0);
+        tri.insert_items(&items, &mut progress, |_, _| true)?;
         if !tri.engine.is_one_sheeted() {
             tri.engine.try_one_sheet();
         }
@@ -361,27 +380,15 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         self.input_point = vec![PointId::NONE; pts.len()];
         // placeholders: point ids count the dummies until they are dropped
         self.point_input = vec![InputId::NONE; k as usize];
-        for (n, &i) in order.iter().enumerate() {
-            if n % 4096 == 0 {
-                proceed(progress, n)?;
-            }
-            let w = weights.get(i as usize).copied().unwrap_or(0.0);
-            match self
-                .engine
-                .insert_keyed(pts[i as usize], w, keys[i as usize])
-            {
-                Inserted::New(p) => {
-                    // a dummy hidden by a point on it (of a larger weight): start again
-                    // without
-                    if self.engine.hidden_log.iter().any(|h| h.id.0 < k) {
-                        return Ok(false);
-                    }
-                    self.record_new(InputId(i), p);
-                }
-                Inserted::Duplicate(p) if p.0 < k => return Ok(false),
-                Inserted::Duplicate(p) => self.record_duplicate(InputId(i), p),
-                Inserted::Hidden => self.record_hidden(InputId(i), pts[i as usize], w),
-            }
+        let items = items(pts, weights, (order, keys), 0);
+        // (a dummy hidden by a point on it, of a larger weight, or a point on a dummy: start
+        // again without)
+        let kept = self.insert_items(&items, progress, |r, hid| match r {
+            Inserted::Duplicate(p) => p.0 >= k,
+            _ => hid.iter().all(|h| h.id.0 >= k),
+        })?;
+        if !kept {
+            return Ok(false);
         }
         // 1-sheeted: the vertex of dummy point `d` has its id
         for d in 0..k {
@@ -414,12 +421,41 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     /// [`Self::insert_wrapped`] with the point's spatial key computed already.
     fn insert_keyed(&mut self, i: InputId, p: [f64; D], w: f64, key: u64) -> Inserted {
         let r = self.engine.insert_keyed(p, w, key);
+        self.record(i, p, w, r);
+        r
+    }
+
+    /// Records what became of input `i` at `p` of weight `w`.
+    fn record(&mut self, i: InputId, p: [f64; D], w: f64, r: Inserted) {
         match r {
             Inserted::New(v) => self.record_new(i, v),
             Inserted::Duplicate(v) => self.record_duplicate(i, v),
             Inserted::Hidden => self.record_hidden(i, p, w),
         }
-        r
+    }
+
+    /// Inserts `items` (tagged with their input ids) by the engine's parallel insertion and
+    /// records each in the engine's order, while `keep(result, points it hid)` holds: false
+    /// when one does not (the rest unrecorded), `Err` if `progress` stopped it.
+    fn insert_items(
+        &mut self,
+        items: &[Item<[f64; D]>],
+        progress: &mut impl FnMut(usize) -> ControlFlow<()>,
+        keep: impl Fn(Inserted, &[HiddenPoint<[f64; D]>]) -> bool,
+    ) -> Result<bool> {
+        let (log, flow) = self.engine.insert_parallel(items, &mut *progress);
+        if flow.is_break() {
+            return Err(Error::Interrupted);
+        }
+        for (k, r, hid) in log.iter() {
+            if !keep(r, hid) {
+                return Ok(false);
+            }
+            self.engine.hidden_log.extend_from_slice(hid);
+            let (i, p, w, _) = items[k as usize];
+            self.record(InputId(i), p, w, r);
+        }
+        Ok(true)
     }
 
     /// Input `i` became point `p`, after the points it hid left (each renumbering the last
@@ -469,32 +505,27 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         self.input_point
             .resize(first + internal.len(), PointId::NONE);
         let seed = BuildOptions::default().seed ^ first as u64;
-        let mut out = vec![Inserted::New(PointId(0)); internal.len()];
         let (order, keys) = spatial_order(self.space(), internal, seed);
-        for k in order {
-            let k = k as usize;
-            let i = InputId::new(first + k);
-            let w = weights.get(k).copied().unwrap_or(0.0);
-            out[k] = self.insert_keyed(i, internal[k], w, keys[k]);
-        }
+        let items = items(internal, weights, (&order, &keys), first);
+        let unstoppable = &mut |_| ControlFlow::Continue(());
+        let done = self.insert_items(&items, unstoppable, |_, _| true);
+        debug_assert!(matches!(done, Ok(true)));
         // a duplicate inserted before its first occurrence lent the point its coordinates;
-        // (hidden points, and points a later one hid, have no point)
-        for (k, r) in out.iter_mut().enumerate() {
-            let p = self.input_point[first + k];
-            if p == HIDDEN {
-                *r = Inserted::Hidden;
-                continue;
-            }
-            if self.point_input[p.index()].index() == first + k {
-                self.represent(p, internal[k]);
-            }
-            // (ids as they are now: a later point may have hidden one before)
-            *r = match *r {
-                Inserted::Duplicate(_) => Inserted::Duplicate(p),
-                _ => Inserted::New(p),
-            };
-        }
-        out
+        // (hidden points, and points a later one hid, have no point; ids as they are now: a
+        // later point may have hidden one before)
+        (0..internal.len())
+            .map(|k| {
+                let p = self.input_point[first + k];
+                if p == HIDDEN {
+                    Inserted::Hidden
+                } else if self.point_input[p.index()].index() == first + k {
+                    self.represent(p, internal[k]);
+                    Inserted::New(p)
+                } else {
+                    Inserted::Duplicate(p)
+                }
+            })
+            .collect()
     }
 
     /// Removes input point `i`: afterwards the triangulation is the Delaunay triangulation

@@ -68,6 +68,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     /// This triangulation's kind (weighted or not, space and spread) without points.
     pub(super) fn emptied(&self) -> Self {
         let mut tri = Self::new(self.space().clone());
+        tri.engine.set_threads(self.engine.threads());
         if self.engine.is_weighted() {
             tri.engine = Engine::new_weighted(self.space().clone());
             tri.engine.weight_max = self.engine.weight_max;
