@@ -284,5 +284,6 @@ def test_every_thread_count_gives_the_same_arrays():
     # one at a time (the default): the same simplices, stored in another order
     canonical = lambda s: sorted(map(tuple, np.sort(s, axis=1)))
     assert canonical(orbitri.SphericalDelaunay(sph).simplices) == canonical(sphere(2)[0])
-    with pytest.raises(ValueError, match="threads must be at least 1"):
-        orbitri.PeriodicDelaunay(pts3, [1.0, 1.0, 1.0], threads=0)
+    for bad in (0, 10**6):
+        with pytest.raises(ValueError, match="threads must be at least 1 and at most 1024"):
+            orbitri.PeriodicDelaunay(pts3, [1.0, 1.0, 1.0], threads=bad)

@@ -1542,6 +1542,9 @@ fn every_thread_count_writes_the_same_files() {
     for threads in ["2", "3"] {
         assert!(run(threads) == one, "--threads {threads} wrote other files");
     }
-    let o = triangulate_cube(&cube, &["--threads", "0"]);
-    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    for bad in ["0", "5000"] {
+        let o = triangulate_cube(&cube, &["--threads", bad]);
+        assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+        assert!(stderr(&o).contains("--threads"), "{}", stderr(&o));
+    }
 }

@@ -378,7 +378,9 @@ fn in_pool<T: Send>(
 ) -> PyResult<T> {
     match threads {
         None => work(),
-        Some(0) => Err(PyValueError::new_err("threads must be at least 1")),
+        Some(n) if !(1..=1024).contains(&n) => Err(PyValueError::new_err(format!(
+            "threads must be at least 1 and at most 1024, not {n}"
+        ))),
         Some(n) => rayon::ThreadPoolBuilder::new()
             .num_threads(n)
             .build()
