@@ -828,7 +828,7 @@ class PeriodicDelaunay(_Delaunay):
     >>> orbitri.PeriodicDelaunay([[0.1, 0.2, 0.0], [0.6, 0.7, 0.0]], [1.0, 1.0]).dimension
     2
 
-    ``threads=N`` builds in parallel rounds on N threads (and runs the construction's other
+    ``threads=N`` builds in parallel on N threads (and runs the construction's other
     steps on N threads); every N gives the same triangulation, stored the same, so every
     array is the same. The default, ``None``, inserts the points one at a time, which is the
     fastest on one or two cores (see the README).

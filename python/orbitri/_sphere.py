@@ -25,7 +25,7 @@ class SphericalDelaunay:
     ``normalize=True`` to project any non-zero vectors), or ``lonlat`` as longitudes and
     latitudes in degrees (N × 2). A point met again is a duplicate of its first occurrence;
     a point strictly inside the hull of the others (only possible off the sphere by
-    rounding) is ``hidden``; none is lost. ``threads=N`` builds in parallel rounds on N
+    rounding) is ``hidden``; none is lost. ``threads=N`` builds in parallel on N
     threads, with the same result for every N (default: one point at a time).
 
     >>> import numpy as np, orbitri

@@ -33,7 +33,7 @@ fn threads() -> Option<usize> {
 struct Cli {
     #[command(subcommand)]
     command: Command,
-    /// Build the triangulation in parallel rounds on N threads, and compute the cells on N
+    /// Build the triangulation in parallel on N threads, and compute the cells on N
     /// threads (default: the triangulation one point at a time, the cells on all cores).
     /// Every file written is the same whatever N.
     #[arg(long, global = true, value_name = "N", value_parser = clap::value_parser!(u16).range(1..=1024))]

@@ -23,6 +23,22 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// the facets in a random rotation drawn from `rng` (the walk's only state: the
     /// triangulation is only read).
     pub fn walk(&self, q: LiftedOf<S, N>, start: CellId, rng: &mut SplitMix) -> (CellId, S::Elem) {
+        match self.walk_within(q, start, rng, |_| true) {
+            Ok(found) | Err(found) => found,
+        }
+    }
+
+    /// [`Self::walk`] through the cells that `inside` accepts (`start` among them); when it
+    /// would step into another, `Err` with the last cell it accepted (and `q`'s offset in
+    /// its frame).
+    #[inline(always)]
+    pub(super) fn walk_within(
+        &self,
+        q: LiftedOf<S, N>,
+        start: CellId,
+        rng: &mut SplitMix,
+        inside: impl Fn(CellId) -> bool,
+    ) -> Result<(CellId, S::Elem), (CellId, S::Elem)> {
         let (p, mut qo) = q;
         let mut c = start;
         let mut prev = CellId::NONE;
@@ -41,6 +57,9 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 let o = self.space.orient(&s);
                 s[i] = keep;
                 if o == Sign::Negative {
+                    if !inside(d) {
+                        return Err((c, qo));
+                    }
                     let t = self.translation(c, i, d);
                     qo = self.space.relative(qo, t);
                     prev = c;
@@ -48,7 +67,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                     continue 'walk;
                 }
             }
-            return (c, qo);
+            return Ok((c, qo));
         }
     }
 
@@ -129,7 +148,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
 
     /// Replaces the conflict region by the cone from the new vertex `x` (lifted with offset
     /// `qoff` as inserted) over its boundary.
-    fn star_hole(&mut self, x: VertexId, qoff: S::Elem) {
+    pub(super) fn star_hole(&mut self, x: VertexId, qoff: S::Elem) {
         let mut scratch = std::mem::take(&mut self.scratch);
         let inside = self.tds.stamp(scratch.conflict[0].0);
         scratch.created.clear();
@@ -226,6 +245,32 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.scratch = scratch;
     }
 
+    /// True when a vertex of the conflict region `conflict` lies on none of its `boundary`
+    /// facets (starring it would hide that vertex).
+    pub(super) fn hides_vertices(
+        &self,
+        conflict: &[(CellId, S::Elem)],
+        boundary: &[(u32, u8)],
+    ) -> bool {
+        if N == 3 {
+            // a disk of `C` triangles and `B` boundary edges has `1 + (C − B)/2` inner
+            // vertices
+            return conflict.len() + 2 != boundary.len();
+        }
+        let on_boundary = |v: VertexId| {
+            boundary.iter().any(|&(ci, i)| {
+                let cell = &self.tds.cells[conflict[ci as usize].0.index()];
+                cell.v
+                    .iter()
+                    .enumerate()
+                    .any(|(k, &w)| k != i as usize && w == v)
+            })
+        };
+        conflict
+            .iter()
+            .any(|&(c, _)| self.tds.cells[c.index()].v.iter().any(|&v| !on_boundary(v)))
+    }
+
     /// True when starring the current conflict region keeps the quotient a simplicial
     /// complex, for a 1-sheeted triangulation without the criterion: every conflict sphere
     /// holds a single lift of the new point, and the new edges (all at the new point) join it
@@ -266,6 +311,20 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         check_duplicate: bool,
         from: Option<(CellId, S::Elem)>,
     ) -> Result<(), Refused> {
+        self.conflict_region(q, x, check_duplicate, from)?;
+        self.star_hole(x, q.1);
+        Ok(())
+    }
+
+    /// The first half of [`Self::insert_lifted`]: locates `q` and collects its conflict
+    /// region (in the scratch), or says why it would not be inserted.
+    pub(super) fn conflict_region(
+        &mut self,
+        q: LiftedOf<S, N>,
+        x: VertexId,
+        check_duplicate: bool,
+        from: Option<(CellId, S::Elem)>,
+    ) -> Result<(), Refused> {
         let (start, shift) = from.unwrap_or_else(|| self.start_cell());
         let (c, qo) = self.locate_from((q.0, self.space.compose(shift, q.1)), start);
         let wq = self.vertex_weight(x);
@@ -290,7 +349,6 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         if self.one_sheeted && !self.guaranteed && !self.star_keeps_simplicial() {
             return Err(Refused::NotSimplicial);
         }
-        self.star_hole(x, q.1);
         Ok(())
     }
 

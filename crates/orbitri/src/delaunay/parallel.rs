@@ -1,65 +1,62 @@
-//! The parallel bulk insertion, by deterministic reservations (Blelloch, Gu, Shun and Sun,
-//! *Parallelism in randomized incremental algorithms*, 2016).
+//! The parallel bulk insertion, by spatial ownership.
 //!
 //! The points arrive in BRIO + Hilbert order. After a short sequential start they go in
-//! waves (the next as many points as there are, so that each wave at most doubles the
-//! triangulation). A wave is cut into chunks of consecutive points along the curve, and
-//! works in rounds that take the next point of every chunk, points far apart from each
-//! other. A round has three parallel steps, over the chunks:
+//! waves, each of the next as many points as there are (so that a wave at most doubles the
+//! triangulation). A wave is sorted along the Hilbert curve and cut into [`CHUNKS`] chunks
+//! of consecutive points, and each chunk **owns** the cells of its stretch of the curve: a
+//! cell belongs to the chunk whose range holds the spatial key of its vertex 0, and a new
+//! cell to the chunk that made it. A chunk inserts its points one after another, as a
+//! sequential insertion would (each walk starts from its last insertion), but only where it
+//! owns everything it reads or writes: the walk, the conflict region and the cells across
+//! its boundary. A point that needs another chunk's cell is deferred. The chunks run on
+//! the threads in any order and at once, with no lock: a cell next to a chunk's own cell
+//! cannot change while it is, since changing it would write the chunk's cell.
 //!
-//! 1. **probe**: each point locates itself (walking from its chunk's last insertion) and
-//!    collects its conflict region and the cells across its boundary, only reading the
-//!    triangulation; then it reserves every cell it would change (an atomic minimum of its
-//!    chunk's number, per cell);
-//! 2. **check**: a point wins when it holds all its reservations;
-//! 3. **commit**: winners star their regions at once, each writing only cells it reserved;
-//!    the others try again in the next round.
+//! The deferred points, on the chunks' borders (a quarter of a wave of uniform points in a
+//! cube with 8 chunks at 10⁶ points, a sixth on the sphere), then go in one after another
+//! by the sequential code. Each point of the wave had its id reserved at the start, in
+//! curve order; the ids of points that did not become vertices (duplicates, and the
+//! sphere's points that would hide others, inserted last by the sequential code) are
+//! filled by the last points.
 //!
-//! Between the steps one thread gives the winners their point ids and new cell slots, in
-//! chunk order. Nothing depends on the number of threads or on timing: the same points win
-//! in the same rounds and get the same ids and cells, so every thread count builds the same
-//! stored triangulation, slot for slot, and writes the same files. (And since the perturbed
-//! Delaunay triangulation is unique, it has the cells of a sequential build.)
-//!
-//! A point that would hide vertices (on the sphere, a point inside the hull of others) is
-//! inserted alone after its round, by the sequential code. Weighted triangulations, and
-//! triangulations still in a covering or without the switch criterion, insert sequentially.
+//! Nothing depends on the number of threads or on timing: a chunk's work depends only on
+//! its own cells, its points and its reserved cell slots, so every thread count stores the
+//! same triangulation, slot for slot, and writes the same files. (Since the perturbed
+//! Delaunay triangulation is unique, its cells are those of a sequential build.) Weighted
+//! triangulations, and triangulations still in a covering or without the switch criterion,
+//! insert sequentially.
 
-use std::ops::ControlFlow;
-use std::sync::atomic::Ordering::{AcqRel, Acquire, Relaxed, Release};
-use std::sync::atomic::{AtomicBool, AtomicPtr, AtomicU32, AtomicUsize};
+use std::ops::{ControlFlow, Range};
+use std::sync::atomic::Ordering::Relaxed;
+use std::sync::atomic::{AtomicU32, AtomicUsize};
 
+use super::insert::Refused;
 use super::{Engine, HiddenPoint, Inserted};
 use crate::ids::{CellId, PointId, VertexId};
 use crate::sort::SplitMix;
 use crate::space::OrbitSpace;
 use crate::tds::Cell;
 
-/// Points inserted one by one before the waves (their regions would overlap).
+/// Points inserted one by one before the waves.
 const SEQUENTIAL_START: usize = 2048;
-/// Points per chunk of a wave, at least.
-const CHUNK: usize = 32;
-/// Chunks per wave, at most, whatever the number of threads (the schedule, and so the
-/// stored triangulation, must not depend on it): few enough that the cells, points and
-/// buffers of each thread's chunks stay in its caches from one round to the next (one
-/// thread took 1.2× longer with 1024 chunks than with 64), enough to keep some 16 threads
-/// busy.
-const MAX_CHUNKS: usize = 64;
-/// Points per segment with threads (one at a time: 4096): `progress` is called between
-/// segments, and waves end with them.
-const SEGMENT: usize = 1 << 16;
-/// Cell slots given to a chunk at a time for its new cells.
-const BLOCK: usize = 64;
-/// A free reservation.
+/// Chunks of a wave, whatever the number of threads (the schedule, and so the stored
+/// triangulation, must not depend on it): as many threads can be busy, and their borders
+/// defer a quarter of a wave (a third with 16 chunks, a sixth with 4; 10⁶ points in a cube).
+const CHUNKS: usize = 8;
+/// Cell slots reserved for a chunk beyond its points' share.
+const MARGIN: usize = 64;
+/// A chunk's points tried, at most, for a first cell it owns.
+const FIRST_TRIES: usize = 16;
+/// An owner that no pass has written.
 const FREE: u32 = u32::MAX;
 
 /// One point to insert: a tag for the caller, the point, its weight (ignored unless the
 /// triangulation is weighted) and its spatial key.
 pub type Item<P> = (u32, P, f64, u64);
 
-/// What became of the items, in the order in which a sequential insertion would have told
-/// it: `(index of the item, result, end of its hidden points in `hidden`)`. New points appear in the order
-/// of their ids, and each point's hidden points (those its insertion hid, as in
+/// What became of the items: `(index of the item, result, end of its hidden points in
+/// `hidden`)`. New points appear in the order of their ids, a duplicate after the point it
+/// coincides with, and each point's hidden points (those its insertion hid, as in
 /// [`Engine::insert_weighted`]) follow the previous event's.
 #[derive(Debug)]
 pub struct Log<P> {
@@ -79,17 +76,32 @@ impl<P> Log<P> {
     }
 }
 
-/// What a round's probe found for a chunk's point.
+/// What a chunk's probe found for its next point.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Found {
     /// The point coincides with this one.
     Duplicate(PointId),
     /// Its power cell is empty.
     Hidden,
-    /// Its insertion would hide vertices: the sequential code inserts it after the round.
+    /// Its insertion would hide vertices: the sequential code inserts it after the wave.
     Alone,
-    /// Its conflict region is collected and reserved.
+    /// It needs a cell the chunk does not own.
+    Foreign,
+    /// Its conflict region is collected, and the chunk owns it.
     Region,
+}
+
+/// What became of a point of the wave.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Outcome {
+    /// Not yet inserted.
+    Deferred,
+    /// A vertex, with the id reserved for it.
+    New,
+    Duplicate(PointId),
+    Hidden,
+    /// Left for the sequential code, after the wave.
+    Alone,
 }
 
 /// A small hash map from cell ids to their place in the region (`OUTSIDE` for a cell across
@@ -159,17 +171,18 @@ impl Marks {
     }
 }
 
-/// A chunk of a wave: its items `next..end`, its last insertion, and what the current
-/// round found for its next point.
+/// A chunk of a pass: its points (`range`, into the pass's list), the cell slots it may
+/// fill, its last insertion, and what the probe found for its current point.
 #[derive(Debug)]
 struct Chunk<O, const N: usize> {
-    next: usize,
-    end: usize,
+    id: u32,
+    range: Range<usize>,
     /// The cell of the chunk's last insertion, its vertices (a reused slot fails the check)
     /// and the shift that lifts a point near it into its frame.
     hint: Option<(CellId, [VertexId; N], O)>,
     found: Found,
-    won: bool,
+    /// Its cell slots ran out: its other points are deferred.
+    full: bool,
     /// The region: cells with the point's offset in each one's frame, in search order.
     conflict: Vec<(CellId, O)>,
     /// Its boundary facets: (index into `conflict`, facet).
@@ -177,52 +190,79 @@ struct Chunk<O, const N: usize> {
     /// Per boundary facet: the cell across and the facet's index there.
     across: Vec<(CellId, u8)>,
     marks: Marks,
-    /// Winners: the point's id and the first of its new cell slots past the region's own.
-    point: PointId,
-    extra: usize,
-    /// Free slots kept for the chunk's new cells (so that its cells lie together in
-    /// memory, as a sequential insertion's do).
-    block: std::ops::Range<usize>,
+    /// Free slots for the chunk's new cells: freed ones first (its regions' leftovers),
+    /// then `fresh`.
+    spare: Vec<CellId>,
+    fresh: Range<usize>,
+    /// What became of its points: (position in the wave, outcome), deferred ones omitted.
+    outcomes: Vec<(u32, Outcome)>,
     /// Buffers of `commit`: the region's cells as they were, the new cells, their slots and,
     /// per region cell and facet, the new cell on it.
     old: Vec<Cell<O, N>>,
-    fresh: Vec<Cell<O, N>>,
+    new: Vec<Cell<O, N>>,
     ids: Vec<CellId>,
     on_facet: Vec<[u32; N]>,
 }
 
 impl<O, const N: usize> Chunk<O, N> {
-    /// The chunk of items `range`.
-    fn new(range: std::ops::Range<usize>) -> Self {
+    fn new(id: usize, range: Range<usize>, spare: Vec<CellId>, fresh: Range<usize>) -> Self {
         Chunk {
-            next: range.start,
-            end: range.end,
+            id: id as u32,
+            range,
             hint: None,
-            found: Found::Hidden,
-            won: false,
+            found: Found::Foreign,
+            full: false,
             conflict: Vec::new(),
             boundary: Vec::new(),
             across: Vec::new(),
             marks: Marks::new(),
-            point: PointId::NONE,
-            extra: 0,
-            block: 0..0,
+            spare,
+            fresh,
+            outcomes: Vec::new(),
             old: Vec::new(),
-            fresh: Vec::new(),
+            new: Vec::new(),
             ids: Vec::new(),
             on_facet: Vec::new(),
         }
     }
+
+    /// The chunk's cell slots that no cell took.
+    fn leftover(&mut self) -> impl Iterator<Item = CellId> {
+        let fresh = std::mem::replace(&mut self.fresh, 0..0);
+        std::mem::take(&mut self.spare)
+            .into_iter()
+            .chain(fresh.map(CellId::new))
+    }
 }
 
-/// The cell store, written by several winners at once, each only in the slots it reserved.
+/// The state kept across the waves of one parallel insertion.
+#[derive(Debug, Default)]
+struct Shared {
+    /// Per cell slot: `pass << 8 | chunk` of the pass that made the cell.
+    owner: Vec<AtomicU32>,
+    /// Per point: its spatial key (stale for points renumbered by a hiding insertion,
+    /// which only moves chunk borders).
+    keys: Vec<u64>,
+    /// The current pass.
+    pass: u32,
+}
+
+/// Which chunk of the current pass owns a cell: the one that made it in this pass, else
+/// the one whose key range holds the key of its vertex 0.
+struct Ownership<'a> {
+    /// The first key of each chunk but the first.
+    bounds: Vec<u64>,
+    pass: u32,
+    owner: &'a [AtomicU32],
+    keys: &'a [u64],
+}
+
+/// The cell store, written by several chunks at once, each only in the cells it owns and
+/// its own slots.
 struct SharedCells<O, const N: usize> {
     base: *mut Cell<O, N>,
     len: usize,
 }
-
-// SAFETY: winners write disjoint slots (their reservations) and read only those.
-unsafe impl<O: Send, const N: usize> Sync for SharedCells<O, N> {}
 
 impl<O: Copy, const N: usize> SharedCells<O, N> {
     /// # Safety
@@ -234,9 +274,85 @@ impl<O: Copy, const N: usize> SharedCells<O, N> {
     }
 }
 
+/// What the threads of a pass share: the engine, read (each chunk only where it owns or
+/// next to it), and the means to write the cells and vertices it owns.
+struct Pass<'a, S: OrbitSpace<N>, const N: usize> {
+    engine: &'a Engine<S, N>,
+    cells: SharedCells<S::Elem, N>,
+    vcell: &'a [AtomicU32],
+    own: Ownership<'a>,
+    wave: &'a [Item<S::Point>],
+    list: &'a [u32],
+    /// The id of the wave's first point.
+    base: usize,
+    chunks: *mut Chunk<S::Elem, N>,
+    count: usize,
+    next: AtomicUsize,
+}
+
+// SAFETY: each chunk is taken by one thread (`next`), and writes only the cells it owns
+// and its own slots, which no other chunk reads (see the module's comment).
+unsafe impl<S: OrbitSpace<N>, const N: usize> Sync for Pass<'_, S, N> {}
+
+impl<S: OrbitSpace<N>, const N: usize> Pass<'_, S, N> {
+    /// Runs chunks until none is left.
+    fn work(&self) {
+        loop {
+            let j = self.next.fetch_add(1, Relaxed);
+            if j >= self.count {
+                return;
+            }
+            // SAFETY: chunk `j` is this thread's alone (`next`).
+            let ch = unsafe { &mut *self.chunks.add(j) };
+            unsafe { self.run(ch) };
+        }
+    }
+
+    /// A chunk's points, one after another.
+    ///
+    /// # Safety
+    /// The chunk is this thread's alone.
+    unsafe fn run(&self, ch: &mut Chunk<S::Elem, N>) {
+        let stamp = self.own.pass << 8 | ch.id;
+        for s in ch.range.clone() {
+            if ch.full {
+                break;
+            }
+            let pos = self.list[s] as usize;
+            self.engine.probe(self.wave[pos], ch, &self.own);
+            let outcome = match ch.found {
+                Found::Region => {
+                    let x = VertexId::new(self.base + pos);
+                    let e = self.engine;
+                    if commit(
+                        &e.space,
+                        e.level,
+                        &self.cells,
+                        self.vcell,
+                        stamp,
+                        &self.own,
+                        ch,
+                        x,
+                    ) {
+                        Outcome::New
+                    } else {
+                        ch.full = true;
+                        continue;
+                    }
+                }
+                Found::Duplicate(p) => Outcome::Duplicate(p),
+                Found::Hidden => Outcome::Hidden,
+                Found::Alone => Outcome::Alone,
+                Found::Foreign => continue,
+            };
+            ch.outcomes.push((pos as u32, outcome));
+        }
+    }
+}
+
 impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
-    /// Bulk insertions ([`Self::insert_parallel`]) run in parallel rounds on `threads`
-    /// threads (at least one), or one by one for `None` (the default).
+    /// Bulk insertions ([`Self::insert_parallel`]) run in parallel on `threads` threads
+    /// (at least one), or one by one for `None` (the default).
     pub fn set_threads(&mut self, threads: Option<usize>) {
         self.threads = threads.map_or(0, |n| n.max(1));
     }
@@ -247,7 +363,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     }
 
     /// True when the next insertions may run in parallel: a 1-sheeted, unweighted
-    /// triangulation whose switch criterion holds, large enough that regions seldom meet.
+    /// triangulation whose switch criterion holds, large enough that chunks seldom meet.
     fn parallel_ready(&self) -> bool {
         self.threads > 0
             && self.one_sheeted
@@ -256,13 +372,13 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             && self.points.len() >= SEQUENTIAL_START
     }
 
-    /// Inserts `items` in their order: one by one, or once [`Self::set_threads`] asked
-    /// for threads, in parallel rounds where the triangulation allows (see the module's
+    /// Inserts `items`: one by one in their order, or once [`Self::set_threads`] asked for
+    /// threads, in parallel waves where the triangulation allows (see the module's
     /// comment). The triangulation is that of inserting them one by one; with threads, it
     /// is stored the same, slot for slot, whatever their number. `progress` is called with
-    /// the number of items done: with 0 first, then every 4096 items (65 536 with threads;
-    /// not at the end); [`ControlFlow::Break`] stops the insertion (the items not yet done
-    /// are not in the log).
+    /// the number of items done: with 0 first, then every 4096 items one by one and after
+    /// each wave (not at the end); [`ControlFlow::Break`] stops the insertion (the items
+    /// not yet done are not in the log).
     pub fn insert_parallel(
         &mut self,
         items: &[Item<S::Point>],
@@ -272,24 +388,22 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             events: Vec::with_capacity(items.len()),
             hidden: Vec::new(),
         };
-        let mut owner: Vec<AtomicU32> = Vec::new();
-        let threads = self.threads;
+        let mut shared = Shared::default();
         let mut k = 0;
         while k < items.len() {
             if progress(k).is_break() {
                 return (log, ControlFlow::Break(()));
             }
-            let segment = if threads > 0 { SEGMENT } else { 4096 };
-            let end = (k + segment).min(items.len());
-            while k < end {
-                if !self.parallel_ready() {
-                    self.insert_alone(items, k, &mut log);
-                    k += 1;
-                    continue;
-                }
-                let m = (end - k).min(self.points.len());
-                self.wave(&items[..k + m], k, threads, &mut owner, &mut log);
+            if self.parallel_ready() {
+                let m = (items.len() - k).min(self.points.len());
+                self.wave(items, k..k + m, &mut shared, &mut log);
                 k += m;
+                continue;
+            }
+            let end = (k + 4096).min(items.len());
+            while k < end && !self.parallel_ready() {
+                self.insert_alone(items, k, &mut log);
+                k += 1;
             }
         }
         (log, ControlFlow::Continue(()))
@@ -303,75 +417,287 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         log.events.push((k as u32, r, log.hidden.len() as u32));
     }
 
-    /// One wave: `items[first..]` in rounds over its chunks, by `threads` threads, each
-    /// with its own run of chunks (their cells stay in its caches), meeting at a spinning
-    /// barrier between the steps (a round takes some ten microseconds per thread: handing
-    /// each step to a pool would cost more).
+    /// One wave: `items[range]`, sorted along the curve, their ids reserved in that order;
+    /// a pass of [`CHUNKS`] chunks on the threads, a pass of one chunk for the points it
+    /// deferred, then the ids of the points that did not become vertices filled, the log
+    /// written and the points that would hide others inserted by the sequential code.
     fn wave(
         &mut self,
         items: &[Item<S::Point>],
-        first: usize,
-        threads: usize,
-        owner: &mut Vec<AtomicU32>,
+        range: Range<usize>,
+        shared: &mut Shared,
         log: &mut Log<S::Point>,
     ) {
-        let m = items.len() - first;
-        let k = (m / CHUNK).clamp(1, MAX_CHUNKS);
-        let mut chunks: Vec<Chunk<S::Elem, N>> = (0..k)
-            .map(|j| Chunk::new(first + j * m / k..first + (j + 1) * m / k))
+        let mut wave: Vec<Item<S::Point>> = range
+            .map(|k| {
+                let (_, p, w, key) = items[k];
+                (k as u32, p, w, key)
+            })
             .collect();
-        let threads = threads.min(k);
-        let mut spares = Vec::new();
-        owner.resize_with(self.tds.cells.len(), || AtomicU32::new(FREE));
-        let wave = Wave {
-            engine: self,
-            chunks: chunks.as_mut_ptr(),
-            owner,
-            log,
-            items,
-            runs: (0..=threads).map(|t| t * k / threads).collect(),
-            barrier: SpinBarrier::new(threads),
-            stop: AtomicBool::new(false),
-            alone: AtomicBool::new(false),
-            cells: AtomicPtr::new(std::ptr::null_mut()),
-            vcell: AtomicPtr::new(std::ptr::null_mut()),
-            spares: &mut spares,
-            poisoned: AtomicBool::new(false),
-        };
-        std::thread::scope(|s| {
-            for t in 1..threads {
-                let wave = &wave;
-                s.spawn(move || wave.run(t));
+        wave.sort_unstable_by_key(|&(k, .., key)| (key, k));
+        let base = self.points.len();
+        shared.keys.truncate(base);
+        let missing: Vec<u64> = self.points[shared.keys.len()..]
+            .iter()
+            .map(|p| self.space.spatial_key(p))
+            .collect();
+        shared.keys.extend(missing);
+        for &(_, p, _, key) in &wave {
+            self.points.push(p);
+            self.vpoint.push(PointId::new(self.vpoint.len()));
+            self.vcell.push(CellId::NONE);
+            shared.keys.push(key);
+        }
+        let m = wave.len();
+        let mut outcome = vec![Outcome::Deferred; m];
+        let all: Vec<u32> = (0..m as u32).collect();
+        self.pass(&wave, &all, base, CHUNKS, shared, &mut outcome);
+        let rest: Vec<u32> = all
+            .into_iter()
+            .filter(|&s| outcome[s as usize] == Outcome::Deferred)
+            .collect();
+        self.insert_deferred(&wave, &rest, base, &mut outcome);
+        // the ids of points that are not vertices, filled by the last points
+        let mut id = (base..base + m).collect::<Vec<usize>>();
+        let hole = |s: usize| outcome[s] != Outcome::New;
+        for h in (0..m).filter(|&s| hole(s)) {
+            while self.points.len() > base + h + 1 && hole(self.points.len() - 1 - base) {
+                self.pop_point();
+                self.vpoint.pop();
+                self.vcell.pop();
             }
-            wave.run(0);
-        });
-        let unused = chunks.iter_mut().flat_map(|c| std::mem::take(&mut c.block));
-        for d in spares.into_iter().chain(unused.map(CellId::new)) {
+            if self.points.len() <= base + h + 1 {
+                if self.points.len() == base + h + 1 {
+                    self.pop_point();
+                    self.vpoint.pop();
+                    self.vcell.pop();
+                }
+                break;
+            }
+            let last = self.points.len() - 1;
+            id[last - base] = base + h;
+            self.renumber_last_point(PointId::new(base + h));
+            shared.keys[base + h] = shared.keys[last];
+        }
+        shared.keys.truncate(self.points.len());
+        let mut new: Vec<(usize, usize)> =
+            (0..m).filter(|&s| !hole(s)).map(|s| (id[s], s)).collect();
+        new.sort_unstable();
+        for (v, s) in new {
+            self.note_vertex(VertexId::new(v), wave[s].3);
+            log.events.push((
+                wave[s].0,
+                Inserted::New(PointId::new(v)),
+                log.hidden.len() as u32,
+            ));
+        }
+        let mut alone = Vec::new();
+        for (s, &o) in outcome.iter().enumerate() {
+            let r = match o {
+                Outcome::New => continue,
+                Outcome::Duplicate(q) if q.index() >= base => {
+                    Inserted::Duplicate(PointId::new(id[q.index() - base]))
+                }
+                Outcome::Duplicate(q) => Inserted::Duplicate(q),
+                Outcome::Hidden => Inserted::Hidden,
+                Outcome::Alone | Outcome::Deferred => {
+                    alone.push(wave[s].0 as usize);
+                    continue;
+                }
+            };
+            log.events.push((wave[s].0, r, log.hidden.len() as u32));
+        }
+        alone.sort_unstable();
+        for k in alone {
+            self.insert_alone(items, k, log);
+        }
+    }
+
+    /// The points `rest` of the wave that its chunks deferred (on their borders), one
+    /// after another by the sequential code, each as its reserved vertex; a point that
+    /// would hide vertices is left for after the wave.
+    fn insert_deferred(
+        &mut self,
+        wave: &[Item<S::Point>],
+        rest: &[u32],
+        base: usize,
+        outcome: &mut [Outcome],
+    ) {
+        let mut last = usize::MAX;
+        for &s in rest {
+            let s = s as usize;
+            let (_, p, _, key) = wave[s];
+            let slot = self.grid_slot(key);
+            // (along the borders the next point may be far: jump when it is)
+            let from = if std::mem::replace(&mut last, slot).abs_diff(slot) > 1 {
+                self.jump(key)
+            } else {
+                None
+            };
+            let x = VertexId::new(base + s);
+            outcome[s] = match self.conflict_region((p, self.space.identity()), x, true, from) {
+                Ok(()) if self.hides() && self.scratch_hides() => Outcome::Alone,
+                Ok(()) => {
+                    self.star_hole(x, self.space.identity());
+                    Outcome::New
+                }
+                Err(Refused::Duplicate(v)) => Outcome::Duplicate(self.vpoint[v.index()]),
+                Err(Refused::Hidden) => Outcome::Hidden,
+                Err(Refused::NotSimplicial) => unreachable!("the criterion holds"),
+            };
+        }
+    }
+
+    /// True when starring the conflict region in the scratch would hide vertices.
+    fn scratch_hides(&self) -> bool {
+        self.hides_vertices(&self.scratch.conflict, &self.scratch.boundary)
+    }
+
+    /// One pass over the wave's points `list` (positions in `wave`, whose point at
+    /// position `s` has id `base + s`) in `count` chunks, on the engine's threads.
+    fn pass(
+        &mut self,
+        wave: &[Item<S::Point>],
+        list: &[u32],
+        base: usize,
+        count: usize,
+        shared: &mut Shared,
+        outcome: &mut [Outcome],
+    ) {
+        let n = list.len();
+        let count = count.clamp(1, n.max(1));
+        shared.pass += 1;
+        if shared.pass >= 1 << 24 {
+            shared.owner.iter_mut().for_each(|o| *o.get_mut() = FREE);
+            shared.pass = 1;
+        }
+        // cell slots for each chunk: free ones, then new ones (a vertex makes `2` more
+        // triangles on a surface, some 6.8 more tetrahedra in a volume)
+        let per = if N == 3 { 2 } else { 8 };
+        let mut free = self.tds.take_free();
+        let mut slots = self.tds.cells.len();
+        let mut chunks: Vec<Chunk<S::Elem, N>> = (0..count)
+            .map(|j| {
+                let range = j * n / count..(j + 1) * n / count;
+                let need = range.len() * per + MARGIN;
+                let spare = free.split_off(free.len() - need.min(free.len()));
+                let fresh = slots..slots + need - spare.len();
+                slots = fresh.end;
+                Chunk::new(j, range, spare, fresh)
+            })
+            .collect();
+        for d in free {
             self.tds.delete(d);
         }
-        // (a sequential insertion lost the criterion: the rest one by one)
-        for c in &chunks {
-            for k in c.next..c.end {
-                self.insert_alone(items, k, log);
+        let dead = Cell::new([VertexId::NONE; N], [self.space.identity(); N]);
+        self.tds.cells.resize(slots, dead);
+        shared.owner.resize_with(slots, || AtomicU32::new(FREE));
+        let own = Ownership {
+            bounds: (1..count)
+                .map(|j| wave[list[j * n / count] as usize].3)
+                .collect(),
+            pass: shared.pass,
+            owner: &shared.owner,
+            keys: &shared.keys,
+        };
+        for ch in &mut chunks {
+            self.find_start(ch, wave, list, &own);
+        }
+        let cells = SharedCells {
+            base: self.tds.cells.as_mut_ptr(),
+            len: slots,
+        };
+        let vcell_len = self.vcell.len();
+        // SAFETY: `AtomicU32` has the layout of `u32`, and so of `CellId`; the pointer
+        // comes from a mutable borrow, and during the pass the vertices' cells are read and
+        // written only through it.
+        let vcell: &[AtomicU32] =
+            unsafe { std::slice::from_raw_parts(self.vcell.as_mut_ptr().cast(), vcell_len) };
+        let threads = self.threads.clamp(1, count);
+        let pass = Pass {
+            engine: &*self,
+            cells,
+            vcell,
+            own,
+            wave,
+            list,
+            base,
+            chunks: chunks.as_mut_ptr(),
+            count,
+            next: AtomicUsize::new(0),
+        };
+        if threads == 1 {
+            pass.work();
+        } else {
+            std::thread::scope(|s| {
+                for _ in 1..threads {
+                    s.spawn(|| pass.work());
+                }
+                pass.work();
+            });
+        }
+        for ch in &mut chunks {
+            for &(s, o) in &ch.outcomes {
+                outcome[s as usize] = o;
+            }
+            for d in ch.leftover() {
+                self.tds.delete(d);
             }
         }
     }
 
-    /// The probe of a round: locates the chunk's next point and collects its region (only
-    /// reading the triangulation).
-    fn probe(&self, (_, p, _, key): Item<S::Point>, ch: &mut Chunk<S::Elem, N>) {
+    /// Finds a cell that chunk `ch` owns next to one of its first points, to walk from.
+    fn find_start(
+        &self,
+        ch: &mut Chunk<S::Elem, N>,
+        wave: &[Item<S::Point>],
+        list: &[u32],
+        own: &Ownership,
+    ) {
+        for s in ch.range.clone().take(FIRST_TRIES) {
+            let (_, p, _, key) = wave[list[s] as usize];
+            let (c, shift) = self.jump(key).unwrap_or_else(|| self.start_cell());
+            let (c, q) = self.walk((p, shift), c, &mut SplitMix::new(key));
+            if self.owner_of(own, c) == ch.id {
+                ch.hint = Some((c, self.tds.cells[c.index()].v, q));
+                return;
+            }
+        }
+    }
+
+    /// The chunk that owns live cell `c` in the current pass.
+    #[inline]
+    fn owner_of(&self, own: &Ownership, c: CellId) -> u32 {
+        let s = own.owner[c.index()].load(Relaxed);
+        if s >> 8 == own.pass {
+            return s & 0xff;
+        }
+        let v = self.tds.cells[c.index()].v[0];
+        own.bounds.partition_point(|&b| b <= own.keys[v.index()]) as u32
+    }
+
+    /// The probe of a chunk's next point: locates it (walking from the chunk's last
+    /// insertion) and collects its conflict region, reading only cells the chunk owns and
+    /// their neighbours.
+    fn probe(&self, (_, p, _, key): Item<S::Point>, ch: &mut Chunk<S::Elem, N>, own: &Ownership) {
+        let me = ch.id;
+        let owned = |c: CellId| self.owner_of(own, c) == me;
         let start = ch
             .hint
             .filter(|&(c, v, _)| self.tds.is_alive(c) && self.tds.cells[c.index()].v == v)
-            .map(|(c, _, shift)| (c, shift))
-            .or_else(|| self.jump(key))
-            .unwrap_or_else(|| self.start_cell());
+            .map(|(c, _, shift)| (c, shift));
+        ch.found = Found::Foreign;
+        let Some((c, shift)) = start else { return };
         let mut rng = SplitMix::new(key);
-        let (c0, q0) = self.walk((p, start.1), start.0, &mut rng);
+        let (c0, q0) = match self.walk_within((p, shift), c, &mut rng, owned) {
+            Ok(found) => found,
+            Err(_) => return,
+        };
         for i in 0..N {
             let v = self.tds.cells[c0.index()].v[i];
             if self.space.coincide(self.lifted(c0, i), (p, q0)) {
                 ch.found = Found::Duplicate(self.vpoint[v.index()]);
+                ch.hint = Some((c0, self.tds.cells[c0.index()].v, q0));
                 return;
             }
         }
@@ -394,6 +720,9 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                     Some(OUTSIDE) => {}
                     Some(_) => continue,
                     None => {
+                        if !owned(d) {
+                            return;
+                        }
                         let qd = self.space.relative(qo, self.translation(c, i, d));
                         if self.cell_conflicts(d, (p, qd), 0.0) {
                             ch.marks.insert(d, ch.conflict.len() as u32);
@@ -411,332 +740,59 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             }
             next += 1;
         }
-        ch.found = if self.hides() && self.region_hides(ch) {
+        ch.found = if self.hides() && self.hides_vertices(&ch.conflict, &ch.boundary) {
             Found::Alone
         } else {
             Found::Region
         };
     }
-
-    /// True when a vertex of the region lies on none of its boundary facets (starring it
-    /// would hide that vertex).
-    fn region_hides(&self, ch: &Chunk<S::Elem, N>) -> bool {
-        if N == 3 {
-            // a disk of `C` triangles and `B` boundary edges has `1 + (C − B)/2` inner
-            // vertices
-            return ch.conflict.len() + 2 != ch.boundary.len();
-        }
-        let on_boundary = |v: VertexId| {
-            ch.boundary.iter().any(|&(ci, i)| {
-                let cell = &self.tds.cells[ch.conflict[ci as usize].0.index()];
-                cell.v
-                    .iter()
-                    .enumerate()
-                    .any(|(k, &w)| k != i as usize && w == v)
-            })
-        };
-        ch.conflict
-            .iter()
-            .any(|&(c, _)| self.tds.cells[c.index()].v.iter().any(|&v| !on_boundary(v)))
-    }
 }
 
-/// The state of a wave shared by its threads. Between barriers, either every thread reads
-/// the engine and works on its own run of chunks (`runs[t]..runs[t + 1]`), or thread 0
-/// alone changes the engine, the chunks, the reservations and the log.
-struct Wave<'a, S: OrbitSpace<N>, const N: usize> {
-    engine: *mut Engine<S, N>,
-    chunks: *mut Chunk<S::Elem, N>,
-    owner: *mut Vec<AtomicU32>,
-    log: *mut Log<S::Point>,
-    items: &'a [Item<S::Point>],
-    runs: Vec<usize>,
-    barrier: SpinBarrier,
-    /// Set by thread 0: the wave is over (every chunk done, or the triangulation no
-    /// longer allows parallel insertion).
-    stop: AtomicBool,
-    /// Set by thread 0: some point of the round is inserted alone after the commits.
-    alone: AtomicBool,
-    /// The cell store and the vertices' cells, as thread 0 left them for the commits.
-    cells: AtomicPtr<Cell<S::Elem, N>>,
-    vcell: AtomicPtr<CellId>,
-    /// The slots of the round's regions that no new cell took, for the free list.
-    spares: *mut Vec<CellId>,
-    /// Set when a thread panics: the others stop waiting for it.
-    poisoned: AtomicBool,
-}
-
-// SAFETY: the barrier separates the steps in which the threads share the state read-only
-// (or write disjoint parts of it) from those in which thread 0 alone changes it.
-unsafe impl<S: OrbitSpace<N>, const N: usize> Sync for Wave<'_, S, N> {}
-
-impl<S: OrbitSpace<N>, const N: usize> Wave<'_, S, N> {
-    /// Thread `t`'s rounds.
-    fn run(&self, t: usize) {
-        /// Marks the wave poisoned when its thread unwinds.
-        struct Poison<'a>(&'a AtomicBool);
-        impl Drop for Poison<'_> {
-            fn drop(&mut self) {
-                if std::thread::panicking() {
-                    self.0.store(true, Relaxed);
-                }
-            }
-        }
-        let _poison = Poison(&self.poisoned);
-        let (lo, hi) = (self.runs[t], self.runs[t + 1]);
-        while !self.stop.load(Relaxed) {
-            // 1. probe and reserve
-            {
-                // SAFETY: the engine and reservations are only read here, and the chunks
-                // `lo..hi` are this thread's.
-                let (engine, owner) = unsafe { (&*self.engine, &*self.owner) };
-                let chunks =
-                    unsafe { std::slice::from_raw_parts_mut(self.chunks.add(lo), hi - lo) };
-                for (j, c) in (lo..).zip(chunks.iter_mut()) {
-                    if c.next == c.end {
-                        continue;
-                    }
-                    engine.probe(self.items[c.next], c);
-                    if c.found == Found::Region {
-                        for &(d, _) in &c.conflict {
-                            owner[d.index()].fetch_min(j as u32, Relaxed);
-                        }
-                        for &(d, _) in &c.across {
-                            owner[d.index()].fetch_min(j as u32, Relaxed);
-                        }
-                    }
-                }
-            }
-            self.barrier.wait(&self.poisoned);
-            // 2. check, ids and slots
-            if t == 0 {
-                // SAFETY: the other threads wait at the barrier.
-                unsafe { self.settle() };
-            }
-            self.barrier.wait(&self.poisoned);
-            if self.stop.load(Relaxed) {
-                return;
-            }
-            // 3. commit
-            {
-                // SAFETY: `settle` sized the store; winners touch only what they reserved.
-                let engine = unsafe { &*self.engine };
-                let owner = unsafe { &*self.owner };
-                let cells = SharedCells {
-                    base: self.cells.load(Relaxed),
-                    len: owner.len(),
-                };
-                // SAFETY: `AtomicU32` has the layout of `u32`, and so of `CellId`; the
-                // pointer comes from a mutable borrow (`settle`).
-                let vcell: &[AtomicU32] = unsafe {
-                    std::slice::from_raw_parts(self.vcell.load(Relaxed).cast(), engine.vcell.len())
-                };
-                let chunks =
-                    unsafe { std::slice::from_raw_parts_mut(self.chunks.add(lo), hi - lo) };
-                for (j, c) in (lo..).zip(chunks.iter_mut()) {
-                    if c.next == c.end {
-                        continue;
-                    }
-                    if c.won {
-                        unsafe { commit(&engine.space, engine.level, &cells, vcell, c) };
-                    }
-                    if c.found == Found::Region {
-                        let free = |d: &CellId| {
-                            let _ =
-                                owner[d.index()].compare_exchange(j as u32, FREE, Relaxed, Relaxed);
-                        };
-                        c.conflict.iter().for_each(|(d, _)| free(d));
-                        c.across.iter().for_each(|(d, _)| free(d));
-                    }
-                    if c.won || matches!(c.found, Found::Duplicate(_) | Found::Hidden) {
-                        c.next += 1;
-                    }
-                }
-            }
-            self.barrier.wait(&self.poisoned);
-            // 4. the points inserted alone
-            if self.alone.load(Relaxed) {
-                if t == 0 {
-                    // SAFETY: the other threads wait at the barrier.
-                    unsafe { self.insert_alone() };
-                }
-                self.barrier.wait(&self.poisoned);
-            }
-        }
-    }
-
-    /// Thread 0 between the probes and the commits: decides the winners, gives them point
-    /// ids and cell slots in chunk order, logs the round and notes the new vertices in the
-    /// grid.
-    ///
-    /// # Safety
-    /// The other threads wait at the barrier.
-    unsafe fn settle(&self) {
-        let engine = &mut *self.engine;
-        let owner = &mut *self.owner;
-        let log = &mut *self.log;
-        let spares = &mut *self.spares;
-        // (the last round's spare slots, which its winners marked dead)
-        for d in spares.drain(..) {
-            engine.tds.delete(d);
-        }
-        let chunks = std::slice::from_raw_parts_mut(self.chunks, self.runs[self.runs.len() - 1]);
-        let mut active = false;
-        let mut alone = false;
-        for (j, c) in chunks.iter_mut().enumerate() {
-            let live = c.next < c.end;
-            active |= live;
-            let mine = |d: &CellId| owner[d.index()].load(Relaxed) == j as u32;
-            c.won = live
-                && c.found == Found::Region
-                && c.conflict.iter().all(|(d, _)| mine(d))
-                && c.across.iter().all(|(d, _)| mine(d));
-            alone |= live && c.found == Found::Alone;
-        }
-        if !active {
-            self.stop.store(true, Relaxed);
-        }
-        self.alone.store(alone, Relaxed);
-        let mut slots = engine.tds.cells.len();
-        for c in chunks.iter_mut().filter(|c| c.won) {
-            let (_, p, _, key) = self.items[c.next];
-            c.point = PointId::new(engine.points.len());
-            engine.push_point(p, 0.0);
-            engine.vpoint.push(c.point);
-            engine.vcell.push(CellId::NONE);
-            engine.note_vertex(VertexId(c.point.0), key);
-            log.events.push((
-                c.next as u32,
-                Inserted::New(c.point),
-                log.hidden.len() as u32,
-            ));
-            // (in 3D a ball of `C` cells around `E` inner edges has `2C + 2 − 2E` boundary
-            // facets: the new cells may be fewer than the old, whose spare slots are freed)
-            let extra = c.boundary.len().saturating_sub(c.conflict.len());
-            if c.block.len() < extra {
-                spares.extend(c.block.clone().map(CellId::new));
-                c.block = slots..slots + extra.max(BLOCK);
-                slots = c.block.end;
-            }
-            c.extra = c.block.start;
-            c.block.start += extra;
-            spares.extend(c.conflict.iter().skip(c.boundary.len()).map(|&(d, _)| d));
-        }
-        for c in chunks.iter().filter(|c| c.next < c.end) {
-            let r = match c.found {
-                Found::Duplicate(p) => Inserted::Duplicate(p),
-                Found::Hidden => Inserted::Hidden,
-                _ => continue,
-            };
-            log.events.push((c.next as u32, r, log.hidden.len() as u32));
-        }
-        let dead = Cell::new([VertexId::NONE; N], [engine.space.identity(); N]);
-        engine.tds.cells.resize(slots, dead);
-        owner.resize_with(slots, || AtomicU32::new(FREE));
-        self.cells.store(engine.tds.cells.as_mut_ptr(), Relaxed);
-        self.vcell.store(engine.vcell.as_mut_ptr(), Relaxed);
-    }
-
-    /// Thread 0 after the commits: inserts the round's points that would hide vertices,
-    /// one by one, and stops the wave if the triangulation no longer allows parallel
-    /// insertion.
-    ///
-    /// # Safety
-    /// The other threads wait at the barrier.
-    unsafe fn insert_alone(&self) {
-        let engine = &mut *self.engine;
-        let chunks = std::slice::from_raw_parts_mut(self.chunks, self.runs[self.runs.len() - 1]);
-        for c in chunks.iter_mut() {
-            if c.next < c.end && c.found == Found::Alone {
-                engine.insert_alone(self.items, c.next, &mut *self.log);
-                c.next += 1;
-                c.hint = None;
-            }
-        }
-        if !engine.parallel_ready() {
-            self.stop.store(true, Relaxed);
-        }
-    }
-}
-
-/// A barrier for the threads of a wave that spins (its steps are short), yielding the
-/// processor after a while (when threads outnumber free cores).
-struct SpinBarrier {
-    threads: usize,
-    count: AtomicUsize,
-    generation: AtomicUsize,
-}
-
-impl SpinBarrier {
-    fn new(threads: usize) -> Self {
-        SpinBarrier {
-            threads,
-            count: AtomicUsize::new(0),
-            generation: AtomicUsize::new(0),
-        }
-    }
-
-    /// Waits for every thread; what each did before is visible to all after. Panics when
-    /// `poisoned` is set (a thread that will never come panicked).
-    fn wait(&self, poisoned: &AtomicBool) {
-        let generation = self.generation.load(Acquire);
-        if self.count.fetch_add(1, AcqRel) + 1 == self.threads {
-            self.count.store(0, Relaxed);
-            self.generation.store(generation + 1, Release);
-            return;
-        }
-        let mut spins = 0u32;
-        while self.generation.load(Acquire) == generation {
-            assert!(
-                !poisoned.load(Relaxed),
-                "another thread of the wave panicked"
-            );
-            if spins < 1 << 12 {
-                std::hint::spin_loop();
-                spins += 1;
-            } else {
-                std::thread::yield_now();
-            }
-        }
-    }
-}
-
-/// Stars a winner's region from its new vertex: the new cells take the region's slots
-/// (those left over are marked dead here, and freed by the next `settle`), then slots
-/// `extra..`; they are linked to the cells across the boundary and, around each
-/// new ridge, to each other by rotating through the region (read from local copies, since
-/// the slots are overwritten). Vertices whose cell was in the region point at a new cell.
+/// Stars a chunk's region from its new vertex `x`: the new cells take the region's slots
+/// (those left over become the chunk's spares), then spares and fresh slots of the chunk,
+/// and are stamped its own; they are linked to the cells across the boundary and, around
+/// each new ridge, to each other by rotating through the region (read from local copies,
+/// since the slots are overwritten). Vertices whose cell was in the region point at a new
+/// cell. False, changing nothing, when the chunk has too few slots left.
 ///
 /// # Safety
-/// The chunk won its reservations: no other thread touches its region, the cells across
-/// it, or its extra slots.
+/// The chunk owns its region and the cells across it, and its slots; no other thread
+/// touches them.
+#[allow(clippy::too_many_arguments)]
 unsafe fn commit<S: OrbitSpace<N>, const N: usize>(
     space: &S,
     level: usize,
     cells: &SharedCells<S::Elem, N>,
     vcell: &[AtomicU32],
+    stamp: u32,
+    own: &Ownership,
     ch: &mut Chunk<S::Elem, N>,
-) {
-    let x = VertexId(ch.point.0);
-    let (mut old, mut fresh, mut ids, mut on_facet) = (
+    x: VertexId,
+) -> bool {
+    let extra = ch.boundary.len().saturating_sub(ch.conflict.len());
+    if ch.spare.len() + ch.fresh.len() < extra {
+        return false;
+    }
+    let (mut old, mut new, mut ids, mut on_facet) = (
         std::mem::take(&mut ch.old),
-        std::mem::take(&mut ch.fresh),
+        std::mem::take(&mut ch.new),
         std::mem::take(&mut ch.ids),
         std::mem::take(&mut ch.on_facet),
     );
     old.clear();
     old.extend(ch.conflict.iter().map(|&(c, _)| *cells.get(c)));
     ids.clear();
-    ids.extend(
-        ch.conflict
-            .iter()
-            .map(|&(c, _)| c)
-            .chain((ch.extra..).map(CellId::new))
-            .take(ch.boundary.len()),
-    );
+    ids.extend(ch.conflict.iter().map(|&(c, _)| c).take(ch.boundary.len()));
+    while ids.len() < ch.boundary.len() {
+        let id = ch.spare.pop().unwrap_or_else(|| {
+            ch.fresh.start += 1;
+            CellId::new(ch.fresh.start - 1)
+        });
+        ids.push(id);
+    }
     on_facet.clear();
     on_facet.resize(old.len(), [u32::MAX; N]);
-    fresh.clear();
+    new.clear();
     for (k, &(ci, i)) in ch.boundary.iter().enumerate() {
         let (ci, i) = (ci as usize, i as usize);
         on_facet[ci][i] = k as u32;
@@ -749,15 +805,15 @@ unsafe fn commit<S: OrbitSpace<N>, const N: usize>(
         }
         let slot = cell.index_of(x).expect("the new vertex");
         cell.n[slot] = ch.across[k].0;
-        fresh.push(cell);
+        new.push(cell);
     }
-    for k in 0..fresh.len() {
+    for k in 0..new.len() {
         let (ci, i) = ch.boundary[k];
         for j in 0..N {
-            if fresh[k].n[j] != CellId::NONE {
+            if new[k].n[j] != CellId::NONE {
                 continue;
             }
-            let (mut u, mut w) = (old[ci as usize].v[i as usize], fresh[k].v[j]);
+            let (mut u, mut w) = (old[ci as usize].v[i as usize], new[k].v[j]);
             let mut cur = ci as usize;
             loop {
                 let cc = &old[cur];
@@ -771,17 +827,18 @@ unsafe fn commit<S: OrbitSpace<N>, const N: usize>(
                     }
                     _ => {
                         let k2 = on_facet[cur][kw] as usize;
-                        let ku = fresh[k2].index_of(u).expect("ridge rotation");
-                        fresh[k].n[j] = ids[k2];
-                        fresh[k2].n[ku] = ids[k];
+                        let ku = new[k2].index_of(u).expect("ridge rotation");
+                        new[k].n[j] = ids[k2];
+                        new[k2].n[ku] = ids[k];
                         break;
                     }
                 }
             }
         }
     }
-    for (k, cell) in fresh.iter().enumerate() {
+    for (k, cell) in new.iter().enumerate() {
         *cells.get(ids[k]) = *cell;
+        own.owner[ids[k].index()].store(stamp, Relaxed);
         let (d, jd) = ch.across[k];
         (*cells.get(d)).n[jd as usize] = ids[k];
         for &v in &cell.v {
@@ -791,14 +848,17 @@ unsafe fn commit<S: OrbitSpace<N>, const N: usize>(
             }
         }
     }
-    for &(spare, _) in ch.conflict.iter().skip(fresh.len()) {
+    for &(spare, _) in ch.conflict.iter().skip(new.len()) {
         (*cells.get(spare)).v[0] = VertexId::NONE;
+        own.owner[spare.index()].store(stamp, Relaxed);
+        ch.spare.push(spare);
     }
-    let k = fresh[0].index_of(x).expect("new cells hold the new vertex");
+    let k = new[0].index_of(x).expect("new cells hold the new vertex");
     ch.hint = Some((
         ids[0],
-        fresh[0].v,
-        space.carry(space.identity(), fresh[0].off[k]),
+        new[0].v,
+        space.carry(space.identity(), new[0].off[k]),
     ));
-    (ch.old, ch.fresh, ch.ids, ch.on_facet) = (old, fresh, ids, on_facet);
+    (ch.old, ch.new, ch.ids, ch.on_facet) = (old, new, ids, on_facet);
+    true
 }

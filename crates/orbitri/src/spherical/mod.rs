@@ -345,7 +345,7 @@ impl<S: SphericalSpace> SphericalTriangulation<S> {
         Self::build_with_threads(points, None, progress)
     }
 
-    /// [`Self::build_with`] inserting in parallel rounds on `threads` threads (the
+    /// [`Self::build_with`] inserting in parallel on `threads` threads (the
     /// triangulation is stored the same, slot for slot, whatever their number; so are the
     /// later batches of [`Self::insert_all`]); `None`: one by one.
     pub fn build_with_threads(

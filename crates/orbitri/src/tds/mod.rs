@@ -86,6 +86,11 @@ impl<O: Copy, const N: usize> Tds<O, N> {
         self.free.push(id);
     }
 
+    /// Takes every free slot (the caller fills them or [`Self::delete`]s them again).
+    pub fn take_free(&mut self) -> Vec<CellId> {
+        std::mem::take(&mut self.free)
+    }
+
     /// True if the slot holds a live cell.
     #[inline]
     pub fn is_alive(&self, id: CellId) -> bool {

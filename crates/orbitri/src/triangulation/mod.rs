@@ -83,7 +83,7 @@ pub struct BuildOptions {
     pub seed: u64,
     /// Sort the points spatially (BRIO + Hilbert); otherwise insert in input order.
     pub spatial_sort: bool,
-    /// Insert in parallel rounds on this many threads (the triangulation is stored the
+    /// Insert in parallel on this many threads (the triangulation is stored the
     /// same, slot for slot, whatever their number); `None`: one by one.
     pub threads: Option<usize>,
 }
@@ -252,7 +252,8 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     /// (or if removing a dummy would break the criterion) insert into the covering space.
     ///
     /// `progress` is called with the number of points inserted so far: before the first,
-    /// every 4096 points (65 536 with threads) and at the end. Returning
+    /// every 4096 points (with threads: after each wave, the
+    /// next as many points as there are) and at the end. Returning
     /// [`ControlFlow::Break`] stops the construction, which then returns
     /// [`Error::Interrupted`] (a cancellation hook: keep the callback cheap, it runs between
     /// insertions).
