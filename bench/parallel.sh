@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The parallel construction (issue "Performance", item 2): `orbitri triangulate` one point
-# at a time (the default) against `--threads 1` and `--threads 2` (the parallel rounds), side
+# at a time (the default) against `--threads 1` and `--threads 2` (the parallel build), side
 # by side in one run, alternating per repetition, on N uniform points in the unit cube
 # (`orbitri generate`, case torus) and on the unit sphere (case sphere). Raw lines go to
 # bench/out/parallel_raw.txt; medians are printed per case and command.

@@ -114,6 +114,12 @@ fn sphere_and_projective_plane_builds_are_the_same_for_every_thread_count() {
     // duplicates, and antipodes (duplicates on RP²)
     pts.extend_from_within(0..10);
     pts.push(pts[20].map(|x| -x));
+    // points just inside the hull (hidden), and just outside it (each hides the point it
+    // covers: inserted after its wave, by the sequential code, when that one came first)
+    let (inner, outer): (Vec<[f64; 3]>, Vec<[f64; 3]>) = (100..150)
+        .map(|i| (pts[i].map(|x| x * (1.0 - 1e-12)), pts[i + 100].map(|x| x * (1.0 + 1e-12))))
+        .unzip();
+    pts.extend(inner.into_iter().chain(outer));
     let sorted = |mut faces: Vec<[InputId; 3]>| {
         for f in &mut faces {
             let k = (0..3).min_by_key(|&k| f[k]).unwrap();
@@ -143,6 +149,11 @@ fn sphere_and_projective_plane_builds_are_the_same_for_every_thread_count() {
         (0..pts.len()).map(|i| t.status(InputId::new(i))).collect()
     };
     assert_eq!(statuses(&bulk), statuses(&one_by_one));
+    let hidden = statuses(&bulk)
+        .iter()
+        .filter(|s| matches!(s, Some(Status::Hidden)))
+        .count();
+    assert_eq!(hidden, 100, "the inner points and the points the outer ones cover");
     let rp2 = ProjectiveDelaunay::build_with_threads(&pts, Some(2), go).unwrap();
     assert!(rp2.is_valid().is_ok());
     assert_eq!(rp2.faces().len(), 2 * rp2.number_of_vertices() - 2);

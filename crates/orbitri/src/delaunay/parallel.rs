@@ -189,6 +189,8 @@ struct Chunk<O, const N: usize> {
     boundary: Vec<(u32, u8)>,
     /// Per boundary facet: the cell across and the facet's index there.
     across: Vec<(CellId, u8)>,
+    /// Per region cell and facet: the index of the region cell across, or `OUTSIDE`.
+    links: Vec<[u32; N]>,
     marks: Marks,
     /// Free slots for the chunk's new cells: freed ones first (its regions' leftovers),
     /// then `fresh`.
@@ -196,12 +198,13 @@ struct Chunk<O, const N: usize> {
     fresh: Range<usize>,
     /// What became of its points: (position in the wave, outcome), deferred ones omitted.
     outcomes: Vec<(u32, Outcome)>,
-    /// Buffers of `commit`: the region's cells as they were, the new cells, their slots and,
-    /// per region cell and facet, the new cell on it.
+    /// Buffers of `commit`: the region's cells as they were, the new cells, their slots,
+    /// per region cell and facet the new cell on it, and the vertices whose cell dies.
     old: Vec<Cell<O, N>>,
     new: Vec<Cell<O, N>>,
     ids: Vec<CellId>,
     on_facet: Vec<[u32; N]>,
+    orphans: Vec<VertexId>,
 }
 
 impl<O, const N: usize> Chunk<O, N> {
@@ -215,6 +218,7 @@ impl<O, const N: usize> Chunk<O, N> {
             conflict: Vec::new(),
             boundary: Vec::new(),
             across: Vec::new(),
+            links: Vec::new(),
             marks: Marks::new(),
             spare,
             fresh,
@@ -223,6 +227,7 @@ impl<O, const N: usize> Chunk<O, N> {
             new: Vec::new(),
             ids: Vec::new(),
             on_facet: Vec::new(),
+            orphans: Vec::new(),
         }
     }
 
@@ -666,7 +671,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     }
 
     /// The chunk that owns live cell `c` in the current pass.
-    #[inline]
+    #[inline(always)]
     fn owner_of(&self, own: &Ownership, c: CellId) -> u32 {
         let s = own.owner[c.index()].load(Relaxed);
         if s >> 8 == own.pass {
@@ -707,9 +712,11 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         }
         ch.marks.clear();
         ch.conflict.clear();
+        ch.links.clear();
         ch.boundary.clear();
         ch.across.clear();
         ch.conflict.push((c0, q0));
+        ch.links.push([OUTSIDE; N]);
         ch.marks.insert(c0, 0);
         let mut next = 0;
         while next < ch.conflict.len() {
@@ -718,15 +725,21 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 let d = self.tds.cells[c.index()].n[i];
                 match ch.marks.get(d) {
                     Some(OUTSIDE) => {}
-                    Some(_) => continue,
+                    Some(k) => {
+                        ch.links[next][i] = k;
+                        continue;
+                    }
                     None => {
                         if !owned(d) {
                             return;
                         }
                         let qd = self.space.relative(qo, self.translation(c, i, d));
                         if self.cell_conflicts(d, (p, qd), 0.0) {
-                            ch.marks.insert(d, ch.conflict.len() as u32);
+                            let k = ch.conflict.len() as u32;
+                            ch.marks.insert(d, k);
                             ch.conflict.push((d, qd));
+                            ch.links.push([OUTSIDE; N]);
+                            ch.links[next][i] = k;
                             continue;
                         }
                         ch.marks.insert(d, OUTSIDE);
@@ -773,14 +786,25 @@ unsafe fn commit<S: OrbitSpace<N>, const N: usize>(
     if ch.spare.len() + ch.fresh.len() < extra {
         return false;
     }
-    let (mut old, mut new, mut ids, mut on_facet) = (
+    let (mut old, mut new, mut ids, mut on_facet, mut orphans) = (
         std::mem::take(&mut ch.old),
         std::mem::take(&mut ch.new),
         std::mem::take(&mut ch.ids),
         std::mem::take(&mut ch.on_facet),
+        std::mem::take(&mut ch.orphans),
     );
     old.clear();
     old.extend(ch.conflict.iter().map(|&(c, _)| *cells.get(c)));
+    // (a vertex whose cell is in the region is the chunk's to point elsewhere: no other
+    // chunk writes it meanwhile, since it points at none of their regions)
+    orphans.clear();
+    for (cell, &(c, _)) in old.iter().zip(&ch.conflict) {
+        orphans.extend(
+            cell.v
+                .iter()
+                .filter(|&&v| vcell[v.index()].load(Relaxed) == c.0),
+        );
+    }
     ids.clear();
     ids.extend(ch.conflict.iter().map(|&(c, _)| c).take(ch.boundary.len()));
     while ids.len() < ch.boundary.len() {
@@ -818,19 +842,19 @@ unsafe fn commit<S: OrbitSpace<N>, const N: usize>(
             loop {
                 let cc = &old[cur];
                 let kw = cc.index_of(w).expect("ridge rotation");
-                match ch.marks.get(cc.n[kw]) {
-                    Some(next) if next != OUTSIDE => {
-                        let nb = &old[next as usize];
-                        let m = nb.mirror(ch.conflict[cur].0).expect("symmetric neighbours");
-                        (w, u) = (u, nb.v[m]);
-                        cur = next as usize;
-                    }
-                    _ => {
+                match ch.links[cur][kw] {
+                    OUTSIDE => {
                         let k2 = on_facet[cur][kw] as usize;
                         let ku = new[k2].index_of(u).expect("ridge rotation");
                         new[k].n[j] = ids[k2];
                         new[k2].n[ku] = ids[k];
                         break;
+                    }
+                    next => {
+                        let nb = &old[next as usize];
+                        let m = nb.mirror(ch.conflict[cur].0).expect("symmetric neighbours");
+                        (w, u) = (u, nb.v[m]);
+                        cur = next as usize;
                     }
                 }
             }
@@ -842,8 +866,7 @@ unsafe fn commit<S: OrbitSpace<N>, const N: usize>(
         let (d, jd) = ch.across[k];
         (*cells.get(d)).n[jd as usize] = ids[k];
         for &v in &cell.v {
-            let was = CellId(vcell[v.index()].load(Relaxed));
-            if v == x || matches!(ch.marks.get(was), Some(l) if l != OUTSIDE) {
+            if v == x || orphans.contains(&v) {
                 vcell[v.index()].store(ids[k].0, Relaxed);
             }
         }
@@ -859,6 +882,6 @@ unsafe fn commit<S: OrbitSpace<N>, const N: usize>(
         new[0].v,
         space.carry(space.identity(), new[0].off[k]),
     ));
-    (ch.old, ch.new, ch.ids, ch.on_facet) = (old, new, ids, on_facet);
+    (ch.old, ch.new, ch.ids, ch.on_facet, ch.orphans) = (old, new, ids, on_facet, orphans);
     true
 }
