@@ -117,7 +117,12 @@ fn sphere_and_projective_plane_builds_are_the_same_for_every_thread_count() {
     // points just inside the hull (hidden), and just outside it (each hides the point it
     // covers: inserted after its wave, by the sequential code, when that one came first)
     let (inner, outer): (Vec<[f64; 3]>, Vec<[f64; 3]>) = (100..150)
-        .map(|i| (pts[i].map(|x| x * (1.0 - 1e-12)), pts[i + 100].map(|x| x * (1.0 + 1e-12))))
+        .map(|i| {
+            (
+                pts[i].map(|x| x * (1.0 - 1e-12)),
+                pts[i + 100].map(|x| x * (1.0 + 1e-12)),
+            )
+        })
         .unzip();
     pts.extend(inner.into_iter().chain(outer));
     let sorted = |mut faces: Vec<[InputId; 3]>| {
@@ -153,7 +158,10 @@ fn sphere_and_projective_plane_builds_are_the_same_for_every_thread_count() {
         .iter()
         .filter(|s| matches!(s, Some(Status::Hidden)))
         .count();
-    assert_eq!(hidden, 100, "the inner points and the points the outer ones cover");
+    assert_eq!(
+        hidden, 100,
+        "the inner points and the points the outer ones cover"
+    );
     let rp2 = ProjectiveDelaunay::build_with_threads(&pts, Some(2), go).unwrap();
     assert!(rp2.is_valid().is_ok());
     assert_eq!(rp2.faces().len(), 2 * rp2.number_of_vertices() - 2);

@@ -12,9 +12,8 @@
 //! the threads in any order and at once, with no lock: a cell next to a chunk's own cell
 //! cannot change while it is, since changing it would write the chunk's cell.
 //!
-//! The deferred points, on the chunks' borders (a quarter of a wave of uniform points in a
-//! cube with 8 chunks at 10⁶ points, a sixth on the sphere), then go in one after another
-//! by the sequential code. Each point of the wave had its id reserved at the start, in
+//! The deferred points, on the chunks' borders (a quarter of the last wave of 10⁶ uniform
+//! points in a cube), then go in one after another by the sequential code. Each point of the wave had its id reserved at the start, in
 //! curve order; the ids of points that did not become vertices (duplicates, and the
 //! sphere's points that would hide others, inserted last by the sequential code) are
 //! filled by the last points.
@@ -41,7 +40,7 @@ use crate::tds::Cell;
 const SEQUENTIAL_START: usize = 2048;
 /// Chunks of a wave, whatever the number of threads (the schedule, and so the stored
 /// triangulation, must not depend on it): as many threads can be busy, and their borders
-/// defer a quarter of a wave (a third with 16 chunks, a sixth with 4; 10⁶ points in a cube).
+/// defer a quarter of a wave (44 % with 16 chunks, 16 % with 4; 10⁶ points in a cube).
 const CHUNKS: usize = 8;
 /// Cell slots reserved for a chunk beyond its points' share.
 const MARGIN: usize = 64;
