@@ -6,9 +6,10 @@
 //! of consecutive points, and each chunk **owns** the cells of its stretch of the curve: a
 //! cell belongs to the chunk whose range holds the spatial key of its vertex 0, and a new
 //! cell to the chunk that made it. A chunk inserts its points one after another, as a
-//! sequential insertion would (each walk starts from its last insertion), but only where it
-//! owns everything it reads or writes: the walk, the conflict region and the cells across
-//! its boundary. A point that needs another chunk's cell is deferred. The chunks run on
+//! sequential insertion would (each walk starts from its last insertion, or every 64th from
+//! a cell located before the pass), but only where it owns everything it reads or writes:
+//! the walk, the conflict region and the cells across its boundary. A point that needs
+//! another chunk's cell is deferred. The chunks run on
 //! the threads in any order and at once, with no lock: a cell next to a chunk's own cell
 //! cannot change while it is, since changing it would write the chunk's cell.
 //!
@@ -29,6 +30,8 @@ use std::ops::{ControlFlow, Range};
 use std::sync::atomic::Ordering::Relaxed;
 use std::sync::atomic::{AtomicU32, AtomicUsize};
 
+use rayon::prelude::*;
+
 use super::insert::Refused;
 use super::{Engine, HiddenPoint, Inserted};
 use crate::ids::{CellId, PointId, VertexId};
@@ -44,8 +47,10 @@ const SEQUENTIAL_START: usize = 2048;
 const CHUNKS: usize = 8;
 /// Cell slots reserved for a chunk beyond its points' share.
 const MARGIN: usize = 64;
-/// A chunk's points tried, at most, for a first cell it owns.
-const FIRST_TRIES: usize = 16;
+/// Every this many points of a chunk, one is located before the pass, to walk from (the
+/// others walk from the chunk's last insertion): walks that keep failing, from cells of the
+/// chunk cut off by others', start afresh there.
+const STRIDE: usize = 64;
 /// An owner that no pass has written.
 const FREE: u32 = u32::MAX;
 
@@ -179,6 +184,9 @@ struct Chunk<O, const N: usize> {
     /// The cell of the chunk's last insertion, its vertices (a reused slot fails the check)
     /// and the shift that lifts a point near it into its frame.
     hint: Option<(CellId, [VertexId; N], O)>,
+    /// For every [`STRIDE`]-th point: the cell that held it before the pass, as `hint`,
+    /// when the chunk owned it.
+    starts: Vec<Option<(CellId, [VertexId; N], O)>>,
     found: Found,
     /// Its cell slots ran out: its other points are deferred.
     full: bool,
@@ -212,6 +220,7 @@ impl<O, const N: usize> Chunk<O, N> {
             id: id as u32,
             range,
             hint: None,
+            starts: Vec::new(),
             found: Found::Foreign,
             full: false,
             conflict: Vec::new(),
@@ -244,11 +253,33 @@ impl<O, const N: usize> Chunk<O, N> {
 struct Shared {
     /// Per cell slot: `pass << 8 | chunk` of the pass that made the cell.
     owner: Vec<AtomicU32>,
-    /// Per point: its spatial key (stale for points renumbered by a hiding insertion,
-    /// which only moves chunk borders).
+    /// Per point: its spatial key (stale for points renumbered by a hiding insertion, which
+    /// only moves chunk borders).
     keys: Vec<u64>,
     /// The current pass.
     pass: u32,
+}
+
+impl Shared {
+    /// The keys of `points[..base]`: those not computed yet, or renumbered since.
+    fn sync<S: OrbitSpace<N>, const N: usize>(&mut self, space: &S, points: &[S::Point]) {
+        let base = points.len();
+        self.keys.truncate(base);
+        let from = self.keys.len();
+        self.keys
+            .extend(points[from..].iter().map(|p| space.spatial_key(p)));
+    }
+
+    /// Starts a pass: its number (the owners of earlier passes forgotten when the numbers
+    /// run out).
+    fn next_pass(&mut self) -> u32 {
+        self.pass += 1;
+        if self.pass >= 1 << 24 {
+            self.owner.iter_mut().for_each(|o| *o.get_mut() = FREE);
+            self.pass = 1;
+        }
+        self.pass
+    }
 }
 
 /// Which chunk of the current pass owns a cell: the one that made it in this pass, else
@@ -323,6 +354,16 @@ impl<S: OrbitSpace<N>, const N: usize> Pass<'_, S, N> {
                 break;
             }
             let pos = self.list[s] as usize;
+            let k = s - ch.range.start;
+            if k % STRIDE == 0 {
+                // (the chunk owned the cell, so only it may have changed it since)
+                if let Some((c, v, q)) = ch.starts[k / STRIDE] {
+                    let tds = &self.engine.tds;
+                    if tds.is_alive(c) && tds.cells[c.index()].v == v {
+                        ch.hint = Some((c, v, q));
+                    }
+                }
+            }
             self.engine.probe(self.wave[pos], ch, &self.own);
             let outcome = match ch.found {
                 Found::Region => {
@@ -440,12 +481,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             .collect();
         wave.sort_unstable_by_key(|&(k, .., key)| (key, k));
         let base = self.points.len();
-        shared.keys.truncate(base);
-        let missing: Vec<u64> = self.points[shared.keys.len()..]
-            .iter()
-            .map(|p| self.space.spatial_key(p))
-            .collect();
-        shared.keys.extend(missing);
+        shared.sync(&self.space, &self.points);
         for &(_, p, _, key) in &wave {
             self.points.push(p);
             self.vpoint.push(PointId::new(self.vpoint.len()));
@@ -454,12 +490,23 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         }
         let m = wave.len();
         let mut outcome = vec![Outcome::Deferred; m];
-        let all: Vec<u32> = (0..m as u32).collect();
-        self.pass(&wave, &all, base, CHUNKS, shared, &mut outcome);
-        let rest: Vec<u32> = all
-            .into_iter()
-            .filter(|&s| outcome[s as usize] == Outcome::Deferred)
-            .collect();
+        let deferred = |outcome: &[Outcome]| -> Vec<u32> {
+            (0..m as u32)
+                .filter(|&s| outcome[s as usize] == Outcome::Deferred)
+                .collect()
+        };
+        // the chunks along the curve, then the points on their borders one at a time
+        let all = deferred(&outcome);
+        let pass = shared.next_pass();
+        self.pass(
+            &wave,
+            &all,
+            base,
+            (&shared.keys, pass),
+            &mut shared.owner,
+            &mut outcome,
+        );
+        let rest = deferred(&outcome);
         self.insert_deferred(&wave, &rest, base, &mut outcome);
         // the ids of points that are not vertices, filled by the last points
         let mut id = (base..base + m).collect::<Vec<usize>>();
@@ -558,23 +605,20 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     }
 
     /// One pass over the wave's points `list` (positions in `wave`, whose point at
-    /// position `s` has id `base + s`) in `count` chunks, on the engine's threads.
+    /// position `s` has id `base + s`, sorted by `keys`) in [`CHUNKS`] chunks, on the
+    /// engine's threads: the chunks own the ranges of `keys` (per point) that their points
+    /// span; `pass` numbers the pass, for `owner`.
     fn pass(
         &mut self,
         wave: &[Item<S::Point>],
         list: &[u32],
         base: usize,
-        count: usize,
-        shared: &mut Shared,
+        (keys, pass): (&[u64], u32),
+        owner: &mut Vec<AtomicU32>,
         outcome: &mut [Outcome],
     ) {
         let n = list.len();
-        let count = count.clamp(1, n.max(1));
-        shared.pass += 1;
-        if shared.pass >= 1 << 24 {
-            shared.owner.iter_mut().for_each(|o| *o.get_mut() = FREE);
-            shared.pass = 1;
-        }
+        let count = CHUNKS.min(n.max(1));
         // cell slots for each chunk: free ones, then new ones (a vertex makes `2` more
         // triangles on a surface, some 6.8 more tetrahedra in a volume)
         let per = if N == 3 { 2 } else { 8 };
@@ -595,18 +639,18 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         }
         let dead = Cell::new([VertexId::NONE; N], [self.space.identity(); N]);
         self.tds.cells.resize(slots, dead);
-        shared.owner.resize_with(slots, || AtomicU32::new(FREE));
+        owner.resize_with(slots, || AtomicU32::new(FREE));
         let own = Ownership {
             bounds: (1..count)
-                .map(|j| wave[list[j * n / count] as usize].3)
+                .map(|j| keys[base + list[j * n / count] as usize])
                 .collect(),
-            pass: shared.pass,
-            owner: &shared.owner,
-            keys: &shared.keys,
+            pass,
+            owner,
+            keys,
         };
-        for ch in &mut chunks {
-            self.find_start(ch, wave, list, &own);
-        }
+        chunks
+            .par_iter_mut()
+            .for_each(|ch| self.locate_starts(ch, wave, list, &own));
         let cells = SharedCells {
             base: self.tds.cells.as_mut_ptr(),
             len: slots,
@@ -650,23 +694,24 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         }
     }
 
-    /// Finds a cell that chunk `ch` owns next to one of its first points, to walk from.
-    fn find_start(
+    /// Locates every [`STRIDE`]-th point of chunk `ch`, only reading, before the pass: its
+    /// `starts`.
+    fn locate_starts(
         &self,
         ch: &mut Chunk<S::Elem, N>,
         wave: &[Item<S::Point>],
         list: &[u32],
         own: &Ownership,
     ) {
-        for s in ch.range.clone().take(FIRST_TRIES) {
+        let mut last = None;
+        let starts = ch.range.clone().step_by(STRIDE).map(|s| {
             let (_, p, _, key) = wave[list[s] as usize];
-            let (c, shift) = self.jump(key).unwrap_or_else(|| self.start_cell());
+            let (c, shift) = self.jump(key).or(last).unwrap_or_else(|| self.start_cell());
             let (c, q) = self.walk((p, shift), c, &mut SplitMix::new(key));
-            if self.owner_of(own, c) == ch.id {
-                ch.hint = Some((c, self.tds.cells[c.index()].v, q));
-                return;
-            }
-        }
+            last = Some((c, q));
+            (self.owner_of(own, c) == ch.id).then(|| (c, self.tds.cells[c.index()].v, q))
+        });
+        ch.starts = starts.collect();
     }
 
     /// The chunk that owns live cell `c` in the current pass.
