@@ -23,14 +23,12 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// the facets in a random rotation drawn from `rng` (the walk's only state: the
     /// triangulation is only read).
     pub fn walk(&self, q: LiftedOf<S, N>, start: CellId, rng: &mut SplitMix) -> (CellId, S::Elem) {
-        match self.walk_within(q, start, rng, |_| true) {
-            Ok(found) | Err(found) => found,
-        }
+        self.walk_within(q, start, rng, |_| true)
+            .expect("a walk through every cell ends in one")
     }
 
-    /// [`Self::walk`] through the cells that `inside` accepts (`start` among them); when it
-    /// would step into another, `Err` with the last cell it accepted (and `q`'s offset in
-    /// its frame).
+    /// [`Self::walk`] through the cells that `inside` accepts (`start` among them): `None`
+    /// when it would step into another.
     #[inline(always)]
     pub(super) fn walk_within(
         &self,
@@ -38,7 +36,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         start: CellId,
         rng: &mut SplitMix,
         inside: impl Fn(CellId) -> bool,
-    ) -> Result<(CellId, S::Elem), (CellId, S::Elem)> {
+    ) -> Option<(CellId, S::Elem)> {
         let (p, mut qo) = q;
         let mut c = start;
         let mut prev = CellId::NONE;
@@ -58,7 +56,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 s[i] = keep;
                 if o == Sign::Negative {
                     if !inside(d) {
-                        return Err((c, qo));
+                        return None;
                     }
                     let t = self.translation(c, i, d);
                     qo = self.space.relative(qo, t);
@@ -67,7 +65,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                     continue 'walk;
                 }
             }
-            return Ok((c, qo));
+            return Some((c, qo));
         }
     }
 
@@ -103,11 +101,31 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             return true;
         }
         let (c, qo) = self.locate(p);
-        self.cell_conflicts(c, (p, qo), w)
-            || (0..N).any(|i| {
-                self.vertex_weight(self.tds.cells[c.index()].v[i]) == w
-                    && self.space.coincide(self.lifted(c, i), (p, qo))
+        self.cell_conflicts(c, (p, qo), w) || self.coincident_vertex(c, (p, qo), w).is_some()
+    }
+
+    /// The vertex of cell `c` at the lifted point `q` of weight `wq`, if any (a weighted
+    /// point on another of a different weight hides it or is hidden: no duplicate).
+    #[inline(always)]
+    pub(super) fn coincident_vertex(
+        &self,
+        c: CellId,
+        q: LiftedOf<S, N>,
+        wq: f64,
+    ) -> Option<VertexId> {
+        (0..N)
+            .find(|&i| {
+                self.vertex_weight(self.tds.cells[c.index()].v[i]) == wq
+                    && self.space.coincide(self.lifted(c, i), q)
             })
+            .map(|i| self.tds.cells[c.index()].v[i])
+    }
+
+    /// Drops the last point and its vertex, just pushed (1-sheeted, or one copy pushed).
+    pub(super) fn unpush_point(&mut self) {
+        self.pop_point();
+        self.vpoint.pop();
+        self.vcell.pop();
     }
 
     /// Collects the cells in conflict with the point `p` of weight `wq` (whose circumsphere
@@ -329,15 +347,10 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         let (c, qo) = self.locate_from((q.0, self.space.compose(shift, q.1)), start);
         let wq = self.vertex_weight(x);
         if check_duplicate {
-            for i in 0..N {
-                let v = self.tds.cells[c.index()].v[i];
-                // (a weighted point on another of a different weight hides it or is hidden)
-                if self.space.coincide(self.lifted(c, i), (q.0, qo)) && self.vertex_weight(v) == wq
-                {
-                    self.hint = c;
-                    self.hint_shift = self.space.carry(q.1, qo);
-                    return Err(Refused::Duplicate(v));
-                }
+            if let Some(v) = self.coincident_vertex(c, (q.0, qo), wq) {
+                self.hint = c;
+                self.hint_shift = self.space.carry(q.1, qo);
+                return Err(Refused::Duplicate(v));
             }
         }
         if self.hides() && !self.cell_conflicts(c, (q.0, qo), wq) {
@@ -433,9 +446,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                     Inserted::New(pi)
                 }
                 Err(refused) => {
-                    self.pop_point();
-                    self.vpoint.pop();
-                    self.vcell.pop();
+                    self.unpush_point();
                     match refused {
                         Refused::Duplicate(v) => Inserted::Duplicate(self.vpoint[v.index()]),
                         Refused::Hidden => Inserted::Hidden,
@@ -472,9 +483,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 }
                 if let Err(refused) = inserted {
                     // (refused on the first copy: the others are its images)
-                    self.pop_point();
-                    self.vpoint.pop();
-                    self.vcell.pop();
+                    self.unpush_point();
                     return match refused {
                         Refused::Duplicate(v) => Inserted::Duplicate(self.vpoint[v.index()]),
                         Refused::Hidden => Inserted::Hidden,

@@ -99,11 +99,6 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.jump(key)
     }
 
-    /// The grid cell of spatial key `key`.
-    pub(super) fn grid_slot(&self, key: u64) -> usize {
-        self.locator.slot(key)
-    }
-
     /// A cell near the point with spatial key `key`, and the shift that lifts the point
     /// into its frame: from the grid when its entry is still good, else `None`.
     pub(super) fn jump(&self, key: u64) -> Option<(CellId, S::Elem)> {

@@ -175,7 +175,7 @@ impl Marks {
     }
 }
 
-/// A chunk of a pass: its points (`range`, into the pass's list), the cell slots it may
+/// A chunk of a pass: its points (`range`, positions in the wave), the cell slots it may
 /// fill, its last insertion, and what the probe found for its current point.
 #[derive(Debug)]
 struct Chunk<O, const N: usize> {
@@ -317,7 +317,6 @@ struct Pass<'a, S: OrbitSpace<N>, const N: usize> {
     vcell: &'a [AtomicU32],
     own: Ownership<'a>,
     wave: &'a [Item<S::Point>],
-    list: &'a [u32],
     /// The id of the wave's first point.
     base: usize,
     chunks: *mut Chunk<S::Elem, N>,
@@ -353,21 +352,19 @@ impl<S: OrbitSpace<N>, const N: usize> Pass<'_, S, N> {
             if ch.full {
                 break;
             }
-            let pos = self.list[s] as usize;
             let k = s - ch.range.start;
             if k % STRIDE == 0 {
                 // (the chunk owned the cell, so only it may have changed it since)
-                if let Some((c, v, q)) = ch.starts[k / STRIDE] {
-                    let tds = &self.engine.tds;
-                    if tds.is_alive(c) && tds.cells[c.index()].v == v {
-                        ch.hint = Some((c, v, q));
+                if let Some(start) = ch.starts[k / STRIDE] {
+                    if self.engine.still_there(start) {
+                        ch.hint = Some(start);
                     }
                 }
             }
-            self.engine.probe(self.wave[pos], ch, &self.own);
+            self.engine.probe(self.wave[s], ch, &self.own);
             let outcome = match ch.found {
                 Found::Region => {
-                    let x = VertexId::new(self.base + pos);
+                    let x = VertexId::new(self.base + s);
                     let e = self.engine;
                     if commit(
                         &e.space,
@@ -390,7 +387,7 @@ impl<S: OrbitSpace<N>, const N: usize> Pass<'_, S, N> {
                 Found::Alone => Outcome::Alone,
                 Found::Foreign => continue,
             };
-            ch.outcomes.push((pos as u32, outcome));
+            ch.outcomes.push((s as u32, outcome));
         }
     }
 }
@@ -463,9 +460,9 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     }
 
     /// One wave: `items[range]`, sorted along the curve, their ids reserved in that order;
-    /// a pass of [`CHUNKS`] chunks on the threads, a pass of one chunk for the points it
-    /// deferred, then the ids of the points that did not become vertices filled, the log
-    /// written and the points that would hide others inserted by the sequential code.
+    /// a pass of [`CHUNKS`] chunks on the threads, the points they deferred one at a time,
+    /// then the ids of the points that did not become vertices filled, the log written and
+    /// the points that would hide others inserted by the sequential code.
     fn wave(
         &mut self,
         items: &[Item<S::Point>],
@@ -490,39 +487,18 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         }
         let m = wave.len();
         let mut outcome = vec![Outcome::Deferred; m];
-        let deferred = |outcome: &[Outcome]| -> Vec<u32> {
-            (0..m as u32)
-                .filter(|&s| outcome[s as usize] == Outcome::Deferred)
-                .collect()
-        };
         // the chunks along the curve, then the points on their borders one at a time
-        let all = deferred(&outcome);
-        let pass = shared.next_pass();
-        self.pass(
-            &wave,
-            &all,
-            base,
-            (&shared.keys, pass),
-            &mut shared.owner,
-            &mut outcome,
-        );
-        let rest = deferred(&outcome);
-        self.insert_deferred(&wave, &rest, base, &mut outcome);
+        self.pass(&wave, base, shared, &mut outcome);
+        self.insert_deferred(&wave, base, &mut outcome);
         // the ids of points that are not vertices, filled by the last points
         let mut id = (base..base + m).collect::<Vec<usize>>();
         let hole = |s: usize| outcome[s] != Outcome::New;
         for h in (0..m).filter(|&s| hole(s)) {
-            while self.points.len() > base + h + 1 && hole(self.points.len() - 1 - base) {
-                self.pop_point();
-                self.vpoint.pop();
-                self.vcell.pop();
+            // (the holes at the end, down to `h` itself, are dropped)
+            while self.points.len() > base + h && hole(self.points.len() - 1 - base) {
+                self.unpush_point();
             }
-            if self.points.len() <= base + h + 1 {
-                if self.points.len() == base + h + 1 {
-                    self.pop_point();
-                    self.vpoint.pop();
-                    self.vcell.pop();
-                }
+            if self.points.len() <= base + h {
                 break;
             }
             let last = self.points.len() - 1;
@@ -564,27 +540,16 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         }
     }
 
-    /// The points `rest` of the wave that its chunks deferred (on their borders), one
-    /// after another by the sequential code, each as its reserved vertex; a point that
-    /// would hide vertices is left for after the wave.
-    fn insert_deferred(
-        &mut self,
-        wave: &[Item<S::Point>],
-        rest: &[u32],
-        base: usize,
-        outcome: &mut [Outcome],
-    ) {
-        let mut last = usize::MAX;
-        for &s in rest {
-            let s = s as usize;
-            let (_, p, _, key) = wave[s];
-            let slot = self.grid_slot(key);
-            // (along the borders the next point may be far: jump when it is)
-            let from = if std::mem::replace(&mut last, slot).abs_diff(slot) > 1 {
-                self.jump(key)
-            } else {
-                None
-            };
+    /// The points of the wave that its chunks deferred (on their borders), one after
+    /// another by the sequential code, each as its reserved vertex; a point that would hide
+    /// vertices is left for after the wave.
+    fn insert_deferred(&mut self, wave: &[Item<S::Point>], base: usize, outcome: &mut [Outcome]) {
+        for (s, &(_, p, _, key)) in wave.iter().enumerate() {
+            if outcome[s] != Outcome::Deferred {
+                continue;
+            }
+            // (along the borders the next point may be far: from the grid when it is)
+            let from = self.insertion_start(key);
             let x = VertexId::new(base + s);
             outcome[s] = match self.conflict_region((p, self.space.identity()), x, true, from) {
                 Ok(()) if self.hides() && self.scratch_hides() => Outcome::Alone,
@@ -604,20 +569,18 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.hides_vertices(&self.scratch.conflict, &self.scratch.boundary)
     }
 
-    /// One pass over the wave's points `list` (positions in `wave`, whose point at
-    /// position `s` has id `base + s`, sorted by `keys`) in [`CHUNKS`] chunks, on the
-    /// engine's threads: the chunks own the ranges of `keys` (per point) that their points
-    /// span; `pass` numbers the pass, for `owner`.
+    /// The pass of the wave's points (the point at position `s` has id `base + s`) in
+    /// [`CHUNKS`] chunks, on the engine's threads: the chunks own the ranges of the
+    /// spatial keys that their points span.
     fn pass(
         &mut self,
         wave: &[Item<S::Point>],
-        list: &[u32],
         base: usize,
-        (keys, pass): (&[u64], u32),
-        owner: &mut Vec<AtomicU32>,
+        shared: &mut Shared,
         outcome: &mut [Outcome],
     ) {
-        let n = list.len();
+        let n = wave.len();
+        let pass = shared.next_pass();
         let count = CHUNKS.min(n.max(1));
         // cell slots for each chunk: free ones, then new ones (a vertex makes `2` more
         // triangles on a surface, some 6.8 more tetrahedra in a volume)
@@ -639,18 +602,16 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         }
         let dead = Cell::new([VertexId::NONE; N], [self.space.identity(); N]);
         self.tds.cells.resize(slots, dead);
-        owner.resize_with(slots, || AtomicU32::new(FREE));
+        shared.owner.resize_with(slots, || AtomicU32::new(FREE));
         let own = Ownership {
-            bounds: (1..count)
-                .map(|j| keys[base + list[j * n / count] as usize])
-                .collect(),
+            bounds: (1..count).map(|j| wave[j * n / count].3).collect(),
             pass,
-            owner,
-            keys,
+            owner: &shared.owner,
+            keys: &shared.keys,
         };
         chunks
             .par_iter_mut()
-            .for_each(|ch| self.locate_starts(ch, wave, list, &own));
+            .for_each(|ch| self.locate_starts(ch, wave, &own));
         let cells = SharedCells {
             base: self.tds.cells.as_mut_ptr(),
             len: slots,
@@ -668,7 +629,6 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             vcell,
             own,
             wave,
-            list,
             base,
             chunks: chunks.as_mut_ptr(),
             count,
@@ -696,22 +656,23 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
 
     /// Locates every [`STRIDE`]-th point of chunk `ch`, only reading, before the pass: its
     /// `starts`.
-    fn locate_starts(
-        &self,
-        ch: &mut Chunk<S::Elem, N>,
-        wave: &[Item<S::Point>],
-        list: &[u32],
-        own: &Ownership,
-    ) {
+    fn locate_starts(&self, ch: &mut Chunk<S::Elem, N>, wave: &[Item<S::Point>], own: &Ownership) {
         let mut last = None;
         let starts = ch.range.clone().step_by(STRIDE).map(|s| {
-            let (_, p, _, key) = wave[list[s] as usize];
+            let (_, p, _, key) = wave[s];
             let (c, shift) = self.jump(key).or(last).unwrap_or_else(|| self.start_cell());
             let (c, q) = self.walk((p, shift), c, &mut SplitMix::new(key));
             last = Some((c, q));
             (self.owner_of(own, c) == ch.id).then(|| (c, self.tds.cells[c.index()].v, q))
         });
         ch.starts = starts.collect();
+    }
+
+    /// True when cell `c` still holds the vertices `v` (a hint: a freed and reused slot
+    /// fails).
+    #[inline]
+    fn still_there(&self, (c, v, _): (CellId, [VertexId; N], S::Elem)) -> bool {
+        self.tds.is_alive(c) && self.tds.cells[c.index()].v == v
     }
 
     /// The chunk that owns live cell `c` in the current pass.
@@ -731,24 +692,18 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     fn probe(&self, (_, p, _, key): Item<S::Point>, ch: &mut Chunk<S::Elem, N>, own: &Ownership) {
         let me = ch.id;
         let owned = |c: CellId| self.owner_of(own, c) == me;
-        let start = ch
-            .hint
-            .filter(|&(c, v, _)| self.tds.is_alive(c) && self.tds.cells[c.index()].v == v)
-            .map(|(c, _, shift)| (c, shift));
         ch.found = Found::Foreign;
-        let Some((c, shift)) = start else { return };
-        let mut rng = SplitMix::new(key);
-        let (c0, q0) = match self.walk_within((p, shift), c, &mut rng, owned) {
-            Ok(found) => found,
-            Err(_) => return,
+        let Some((c, _, shift)) = ch.hint.filter(|&h| self.still_there(h)) else {
+            return;
         };
-        for i in 0..N {
-            let v = self.tds.cells[c0.index()].v[i];
-            if self.space.coincide(self.lifted(c0, i), (p, q0)) {
-                ch.found = Found::Duplicate(self.vpoint[v.index()]);
-                ch.hint = Some((c0, self.tds.cells[c0.index()].v, q0));
-                return;
-            }
+        let mut rng = SplitMix::new(key);
+        let Some((c0, q0)) = self.walk_within((p, shift), c, &mut rng, owned) else {
+            return;
+        };
+        if let Some(v) = self.coincident_vertex(c0, (p, q0), 0.0) {
+            ch.found = Found::Duplicate(self.vpoint[v.index()]);
+            ch.hint = Some((c0, self.tds.cells[c0.index()].v, q0));
+            return;
         }
         if self.hides() && !self.cell_conflicts(c0, (p, q0), 0.0) {
             ch.found = Found::Hidden;
