@@ -130,33 +130,45 @@ pub fn hilbert<const D: usize>(mut x: [u32; D], bits: u32) -> u64 {
     h
 }
 
-/// The BRIO insertion order of `keys.len()` items: a random shuffle, split into rounds that
-/// double in size (the last holds half the items), each round sorted by key.
+/// The BRIO insertion order of `keys.len()` items: rounds that double in size (the last
+/// holds about half the items, the first about 64), each sorted by key. An item's round is
+/// drawn from a hash of its index and `seed` (the tails before the first head of a fair
+/// coin, counted back from the last round), so that the rounds are filled in one pass over
+/// the keys in memory order: no shuffle, no lookup of a key at a random place.
 pub fn brio_order(keys: &[u64], seed: u64) -> Vec<u32> {
     let n = keys.len();
-    let mut idx: Vec<u32> = (0..n as u32).collect();
-    let mut rng = SplitMix::new(seed);
-    for i in (1..n).rev() {
-        let j = rng.below(i + 1);
-        idx.swap(i, j);
-    }
-    let mut ends = vec![n];
+    let mut last = 0;
     let mut m = n;
     while m > 64 {
         m /= 2;
-        ends.push(m);
+        last += 1;
     }
-    ends.reverse();
-    // each round sorted as (key, index) pairs: no lookup into `keys` per comparison, which
-    // missed the cache
-    let mut pairs: Vec<(u64, u32)> = idx.iter().map(|&i| (keys[i as usize], i)).collect();
-    let mut start = 0;
-    for end in ends {
+    let round: Vec<u8> = (0..n)
+        .into_par_iter()
+        .map(|i| {
+            let h = SplitMix::new(seed ^ (i as u64).wrapping_mul(0xD6E8_FEB8_6659_FD93)).next_u64();
+            (last - (h.trailing_zeros() as usize).min(last)) as u8
+        })
+        .collect();
+    let mut start = vec![0usize; last + 2];
+    for &r in &round {
+        start[r as usize + 1] += 1;
+    }
+    for r in 0..=last {
+        start[r + 1] += start[r];
+    }
+    let ends = start.clone();
+    let mut pairs = vec![(0u64, 0u32); n];
+    for (i, (&r, &key)) in round.iter().zip(keys).enumerate() {
+        let at = &mut start[r as usize];
+        pairs[*at] = (key, i as u32);
+        *at += 1;
+    }
+    for r in 0..=last {
         // (the pairs are distinct: the parallel sort gives the same order)
-        pairs[start..end].par_sort_unstable();
-        start = end;
+        pairs[ends[r]..ends[r + 1]].par_sort_unstable();
     }
-    pairs.into_iter().map(|(_, i)| i).collect()
+    pairs.into_par_iter().map(|(_, i)| i).collect()
 }
 
 #[cfg(test)]
@@ -275,9 +287,24 @@ mod tests {
         let mut seen = order.clone();
         seen.sort_unstable();
         assert_eq!(seen, (0..1000).collect::<Vec<u32>>());
-        // the last round (second half) is sorted by key
-        assert!(order[500..]
+        // sorted runs, about one a round, the last about half the items
+        let descents = order
             .windows(2)
-            .all(|w| keys[w[0] as usize] <= keys[w[1] as usize]));
+            .filter(|w| keys[w[0] as usize] > keys[w[1] as usize])
+            .count();
+        assert!(
+            (3..=4).contains(&descents),
+            "{descents} rounds after the first"
+        );
+        let tail = order
+            .iter()
+            .rev()
+            .zip(order.iter().rev().skip(1))
+            .take_while(|(a, b)| keys[**b as usize] <= keys[**a as usize])
+            .count();
+        assert!(
+            (400..600).contains(&tail),
+            "the last round holds {tail} items"
+        );
     }
 }

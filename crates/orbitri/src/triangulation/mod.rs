@@ -181,7 +181,7 @@ fn spatial_order<const D: usize, const N: usize, S: FlatSpace<D, N>>(
     points: &[[f64; D]],
     seed: u64,
 ) -> (Vec<u32>, Vec<u64>) {
-    let keys: Vec<u64> = points.iter().map(|p| space.spatial_key(p)).collect();
+    let keys: Vec<u64> = points.par_iter().map(|p| space.spatial_key(p)).collect();
     (crate::sort::brio_order(&keys, seed), keys)
 }
 
