@@ -95,7 +95,7 @@ pub trait OrbitSpace<const N: usize>: Sync + Send {
     }
     /// The circumcenter of the lifted simplex relative to its vertex 0, in Cartesian
     /// coordinates, certified: a floating-point evaluation whose error bound is below
-    /// `2^-44` of its magnitude (and of the simplex's extent) is accepted, otherwise it is
+    /// `2^-36` of its magnitude (and of the simplex's extent) is accepted, otherwise it is
     /// computed exactly and rounded. Infinite coordinates for a flat simplex.
     fn circumcenter(&self, s: &[Lifted<Self::Point, Self::Elem>; N]) -> Self::Point {
         self.orthocenter(s, &[0.0; N])

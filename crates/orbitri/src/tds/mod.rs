@@ -47,6 +47,19 @@ impl<O: Copy, const N: usize> Cell<O, N> {
     }
 }
 
+/// Asks the processor to start loading `x` into its caches (a hint: nothing on other
+/// architectures).
+#[inline(always)]
+pub fn prefetch<T>(x: &T) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: prefetching is only a hint; the pointer comes from a live reference.
+    unsafe {
+        std::arch::x86_64::_mm_prefetch(x as *const T as *const i8, std::arch::x86_64::_MM_HINT_T0)
+    };
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = x;
+}
+
 /// Cell storage with a free list and visit stamps.
 #[derive(Clone, Debug, Default)]
 pub struct Tds<O, const N: usize> {
@@ -129,16 +142,9 @@ impl<O: Copy, const N: usize> Tds<O, N> {
     /// the walk visit them next, and overlapping their cache misses saves more than it costs.
     #[inline(always)]
     pub fn prefetch_neighbours(&self, c: CellId) {
-        #[cfg(target_arch = "x86_64")]
         for &d in &self.cells[c.index()].n {
             if let Some(cell) = self.cells.get(d.index()) {
-                // SAFETY: prefetching is only a hint; the pointer comes from a live reference.
-                unsafe {
-                    std::arch::x86_64::_mm_prefetch(
-                        cell as *const Cell<O, N> as *const i8,
-                        std::arch::x86_64::_MM_HINT_T0,
-                    )
-                };
+                prefetch(cell);
             }
         }
     }

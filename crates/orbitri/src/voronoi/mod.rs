@@ -10,6 +10,8 @@
 //! by the unperturbed in-sphere test) give one Voronoi vertex, and a Delaunay edge whose dual
 //! has collapsed to fewer than `D` vertices is no face (a square grid's diagonals, for example).
 
+mod measures;
+
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
@@ -162,9 +164,21 @@ struct Duals<const D: usize> {
     /// Bit `x` of `cospherical[c]`: cell `c` and its neighbour across facet `x` have one
     /// circumsphere (decided exactly), so they give one Voronoi vertex.
     cospherical: Vec<u8>,
-    /// The incident (cell, slot) pairs of vertex `v`: `incident[start[v]..start[v + 1]]`.
+    stars: Stars,
+}
+
+/// The incident (cell, slot) pairs of every vertex, in one array (a counting sort).
+struct Stars {
+    /// The pairs of vertex `v` are `incident[start[v]..start[v + 1]]`.
     start: Vec<u32>,
     incident: Vec<(CellId, u8)>,
+}
+
+impl Stars {
+    /// The cells around vertex `v`, and the vertex's slot in each.
+    fn of(&self, v: VertexId) -> &[(CellId, u8)] {
+        &self.incident[self.start[v.index()] as usize..self.start[v.index() + 1] as usize]
+    }
 }
 
 impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> {
@@ -188,7 +202,8 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     /// The measures of every distinct point's cell, in the order of first occurrence; the
     /// cells themselves are dropped as soon as measured (for tables of millions of points).
     pub fn voronoi_measures(&self) -> Vec<CellMeasures<D>> {
-        self.per_cell(|c| CellMeasures::from(&c))
+        self.voronoi_measures_until(&|| false)
+            .expect("never interrupted")
     }
 
     /// How many times [`Self::voronoi_cells_until`] and [`Self::voronoi_measures_until`]
@@ -229,7 +244,23 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         &self,
         interrupt: &(dyn Fn() -> bool + Sync),
     ) -> Result<Vec<CellMeasures<D>>> {
-        self.per_cell_until(|c| CellMeasures::from(&c), interrupt)
+        if self.engine().sheets() > 1 {
+            return self.per_cell_until(|c| CellMeasures::from(&c), interrupt);
+        }
+        // by pieces, without the cells; the few points next to two cells of one
+        // circumsphere from their whole cells (not polled: degenerate inputs only)
+        let mut out = self.measures_by_pieces(interrupt)?;
+        if out.iter().any(Option::is_none) {
+            let duals = self.duals(&|| false)?;
+            out.par_iter_mut()
+                .enumerate()
+                .filter(|(_, m)| m.is_none())
+                .for_each_init(CellScratch::default, |scratch, (p, m)| {
+                    let cell = self.cell_of_point(&duals, PointId(p as u32), scratch);
+                    *m = Some(CellMeasures::from(&cell));
+                });
+        }
+        Ok(self.in_input_order(out, |i| CellMeasures::from(&self.hidden_cell(i))))
     }
 
     /// `f` of every cell, computed in parallel in point order (the spatially sorted
@@ -250,7 +281,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             return Err(Error::Interrupted);
         }
         let duals = self.duals(interrupt)?;
-        let mut out: Vec<Option<T>> = (0..self.number_of_vertices() as u32)
+        let out: Vec<Option<T>> = (0..self.number_of_vertices() as u32)
             .into_par_iter()
             .map_init(CellScratch::default, |scratch, p| {
                 if p % POINTS_PER_POLL as u32 == 0 && interrupt() {
@@ -259,19 +290,24 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
                 Ok(Some(f(self.cell_of_point(&duals, PointId(p), scratch))))
             })
             .collect::<Result<_>>()?;
-        // the points, then the hidden inputs (empty cells), by input id
+        Ok(self.in_input_order(out, |i| f(self.hidden_cell(i))))
+    }
+
+    /// The values of the points (`out`, indexed by point, each `Some`) and of the hidden
+    /// inputs (`hidden`), in the order of first occurrence.
+    fn in_input_order<T>(&self, mut out: Vec<Option<T>>, hidden: impl Fn(InputId) -> T) -> Vec<T> {
         let mut order: Vec<(InputId, PointId)> = (0..out.len() as u32)
             .map(|p| (self.input_of_vertex(PointId(p)), PointId(p)))
             .chain(self.hidden().into_iter().map(|i| (i, PointId::NONE)))
             .collect();
         order.sort_unstable();
-        Ok(order
+        order
             .iter()
             .map(|&(i, p)| match p {
-                PointId::NONE => f(self.hidden_cell(i)),
+                PointId::NONE => hidden(i),
                 p => out[p.index()].take().expect("each point once"),
             })
-            .collect())
+            .collect()
     }
 
     /// The empty power cell of hidden input `i`: no vertices or faces, volume 0, its
@@ -307,8 +343,52 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     /// The shared duals, polling `interrupt` every `CELLS_PER_POLL` cells, twice.
     fn duals(&self, interrupt: &(dyn Fn() -> bool + Sync)) -> Result<Duals<D>> {
         let e = self.engine();
-        let space = self.space();
         let ids: Vec<CellId> = e.cell_ids().collect();
+        let center = self.centers(&ids, interrupt)?;
+        if interrupt() {
+            return Err(Error::Interrupted);
+        }
+        // adjacent cells with one circumsphere: decided exactly, each facet once
+        let stopped = std::sync::atomic::AtomicBool::new(false);
+        let merges: Vec<(CellId, usize, CellId)> = ids
+            .par_iter()
+            .enumerate()
+            .flat_map_iter(|(k, &c)| {
+                if k % CELLS_PER_POLL == 0 && interrupt() {
+                    stopped.store(true, std::sync::atomic::Ordering::Relaxed);
+                }
+                let cell = e.cell(c);
+                (0..N).filter_map(move |x| {
+                    let d = cell.n[x];
+                    (d > c && self.one_sphere(c, x, d)).then_some((c, x, d))
+                })
+            })
+            .collect();
+        if stopped.into_inner() {
+            return Err(Error::Interrupted);
+        }
+        let mut cospherical = vec![0u8; center.len()];
+        for (c, x, d) in merges {
+            let y = e.cell(d).mirror(c).expect("symmetric neighbours");
+            cospherical[c.index()] |= 1 << x;
+            cospherical[d.index()] |= 1 << y;
+        }
+        let stars = self.stars(&ids, &|| false)?;
+        Ok(Duals {
+            center,
+            cospherical,
+            stars,
+        })
+    }
+
+    /// Each stored cell's circumcenter (orthocenter), indexed by cell id, polling
+    /// `interrupt` every `CELLS_PER_POLL` cells.
+    fn centers(
+        &self,
+        ids: &[CellId],
+        interrupt: &(dyn Fn() -> bool + Sync),
+    ) -> Result<Vec<[f64; D]>> {
+        let e = self.engine();
         let slots = ids.iter().max().map_or(0, |m| m.index() + 1);
         let computed: Vec<[f64; D]> = ids
             .par_iter()
@@ -318,63 +398,48 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
                     return Err(Error::Interrupted);
                 }
                 // (the circumcenter is the orthocenter of the zero weights unweighted cells have)
-                Ok(space.orthocenter(&e.lifted_cell(c), &e.cell_weights(c)))
+                Ok(self
+                    .space()
+                    .orthocenter(&e.lifted_cell(c), &e.cell_weights(c)))
             })
             .collect::<Result<_>>()?;
         let mut center = vec![[0.0; D]; slots];
         for (k, &c) in ids.iter().enumerate() {
             center[c.index()] = computed[k];
         }
-        if interrupt() {
-            return Err(Error::Interrupted);
+        Ok(center)
+    }
+
+    /// True when cell `c` and its neighbour `d` across facet `x` have one circumsphere
+    /// (orthogonal sphere), decided exactly.
+    fn one_sphere(&self, c: CellId, x: usize, d: CellId) -> bool {
+        let e = self.engine();
+        let space = self.space();
+        let dc = e.cell(d);
+        let y = dc.mirror(c).expect("symmetric neighbours");
+        let opposite = (
+            e.points()[e.point_of(dc.v[y]).index()],
+            space.compose(e.translation(c, x, d), dc.off[y]),
+        );
+        let lifted = e.lifted_cell(c);
+        if e.is_weighted() {
+            let w = e.vertex_weight(dc.v[y]);
+            space.orthogonal(&lifted, &e.cell_weights(c), opposite, w)
+        } else {
+            space.cospherical(&lifted, opposite)
         }
-        // adjacent cells with one circumsphere: decided exactly, each facet once
-        let stopped = std::sync::atomic::AtomicBool::new(false);
-        let merges: Vec<(CellId, usize, CellId, usize)> = ids
-            .par_iter()
-            .enumerate()
-            .flat_map_iter(|(k, &c)| {
-                if k % CELLS_PER_POLL == 0 && interrupt() {
-                    stopped.store(true, std::sync::atomic::Ordering::Relaxed);
-                }
-                let cell = e.cell(c);
-                let lifted = e.lifted_cell(c);
-                (0..N).filter_map(move |x| {
-                    let d = cell.n[x];
-                    if d < c {
-                        return None;
-                    }
-                    let dc = e.cell(d);
-                    let y = (0..N)
-                        .find(|&y| dc.n[y] == c)
-                        .expect("symmetric neighbours");
-                    let shift = e.translation(c, x, d);
-                    let opposite = (
-                        e.points()[e.point_of(dc.v[y]).index()],
-                        space.compose(shift, dc.off[y]),
-                    );
-                    let same = if e.is_weighted() {
-                        let w = e.vertex_weight(dc.v[y]);
-                        space.orthogonal(&lifted, &e.cell_weights(c), opposite, w)
-                    } else {
-                        space.cospherical(&lifted, opposite)
-                    };
-                    same.then_some((c, x, d, y))
-                })
-            })
-            .collect();
-        if stopped.into_inner() {
-            return Err(Error::Interrupted);
-        }
-        let mut cospherical = vec![0u8; slots];
-        for (c, x, d, y) in merges {
-            cospherical[c.index()] |= 1 << x;
-            cospherical[d.index()] |= 1 << y;
-        }
-        // incidence lists by counting sort
+    }
+
+    /// The stars of the vertices of the cells `ids`, polling `interrupt` every
+    /// `CELLS_PER_POLL` cells.
+    fn stars(&self, ids: &[CellId], interrupt: &(dyn Fn() -> bool + Sync)) -> Result<Stars> {
+        let e = self.engine();
         let vertices = e.number_of_vertices();
         let mut start = vec![0u32; vertices + 1];
-        for &c in &ids {
+        for (k, &c) in ids.iter().enumerate() {
+            if k % CELLS_PER_POLL == 0 && interrupt() {
+                return Err(Error::Interrupted);
+            }
             for &v in &e.cell(c).v {
                 start[v.index() + 1] += 1;
             }
@@ -384,18 +449,13 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         }
         let mut fill = start.clone();
         let mut incident = vec![(CellId(0), 0u8); start[vertices] as usize];
-        for &c in &ids {
+        for &c in ids {
             for (k, &v) in e.cell(c).v.iter().enumerate() {
                 incident[fill[v.index()] as usize] = (c, k as u8);
                 fill[v.index()] += 1;
             }
         }
-        Ok(Duals {
-            center,
-            cospherical,
-            start,
-            incident,
-        })
+        Ok(Stars { start, incident })
     }
 
     /// The cell of point `p`, from the cells around one of its vertices.
@@ -416,8 +476,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         } = scratch;
         let e = self.engine();
         let space = self.space();
-        let v = e.vertex_of_point(p).index();
-        let star = &duals.incident[duals.start[v] as usize..duals.start[v + 1] as usize];
+        let star = duals.stars.of(e.vertex_of_point(p));
         let position = e.points()[p.index()];
         // one Voronoi vertex per group of star cells joined, through facets at the point, by
         // a shared circumsphere (so in one lift around the point: a sphere met again around

@@ -1,0 +1,227 @@
+//! The measures of every Voronoi cell (volume, faces, surface area, centroid) without
+//! building the cells. Around a point, each Delaunay facet at the point, shared by cells `t`
+//! and `t'`, and each Delaunay edge `pq` of that facet give one piece of the point's cell:
+//! in 3D the tetrahedron from `p` to the foot `m` of the edge's bisector and the two
+//! circumcenters `c`, `c'` (two consecutive vertices of the edge's dual face), in 2D the
+//! triangle `p c c'`. Signed by the orientation of `t`, the pieces sum to the cell even
+//! when circumcenters lie outside their Delaunay cells, or the point outside its power
+//! cell; the face of edge `pq` is the signed sum of the triangles `m c c'`. Each facet is
+//! taken from the smaller of its two cells, so every point sums its own pieces in a fixed
+//! order: the same numbers whatever the number of threads.
+
+use rayon::prelude::*;
+
+use super::{cross, dot, CellMeasures, POINTS_PER_POLL};
+use crate::error::{Error, Result};
+use crate::ids::{CellId, PointId};
+use crate::space::FlatSpace;
+use crate::tds::prefetch;
+use crate::triangulation::Triangulation;
+
+/// `+1.0` for an even permutation of `0..len`, `-1.0` for an odd one.
+fn parity(perm: &[usize]) -> f64 {
+    let mut odd = false;
+    for a in 0..perm.len() {
+        for b in a + 1..perm.len() {
+            odd ^= perm[a] > perm[b];
+        }
+    }
+    if odd {
+        -1.0
+    } else {
+        1.0
+    }
+}
+
+fn sub<const D: usize>(a: &[f64; D], b: &[f64; D]) -> [f64; D] {
+    std::array::from_fn(|x| a[x] - b[x])
+}
+
+impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> {
+    /// The measures of every point's cell by pieces (see the module), indexed by point;
+    /// `None` for a point with a facet between two cells of one circumsphere (one Voronoi
+    /// vertex: which of its edges keep a face is counted on the whole cell). 1-sheeted only.
+    /// Polls `interrupt` as [`Self::voronoi_polls`] counts.
+    pub(super) fn measures_by_pieces(
+        &self,
+        interrupt: &(dyn Fn() -> bool + Sync),
+    ) -> Result<Vec<Option<CellMeasures<D>>>> {
+        debug_assert_eq!(self.engine().sheets(), 1);
+        if interrupt() {
+            return Err(Error::Interrupted);
+        }
+        let ids: Vec<CellId> = self.engine().cell_ids().collect();
+        let center = self.centers(&ids, interrupt)?;
+        if interrupt() {
+            return Err(Error::Interrupted);
+        }
+        let stars = self.stars(&ids, interrupt)?;
+        // the points along the curve, not in insertion order: the next point's cells are
+        // mostly the last one's, still in cache (a sixth of the time)
+        let e = self.engine();
+        let mut order: Vec<(u64, u32)> = e
+            .points()
+            .par_iter()
+            .enumerate()
+            .map(|(p, x)| (self.space().spatial_key(x), p as u32))
+            .collect();
+        order.par_sort_unstable();
+        let star_of = |k: usize| stars.of(e.vertex_of_point(PointId(order[k].1)));
+        let found: Vec<Option<CellMeasures<D>>> = (0..order.len())
+            .into_par_iter()
+            .map(|k| {
+                if k % POINTS_PER_POLL == 0 && interrupt() {
+                    return Err(Error::Interrupted);
+                }
+                self.prefetch_stars(&center, star_of, k);
+                Ok(self.pieces_of(&center, star_of(k), PointId(order[k].1)))
+            })
+            .collect::<Result<_>>()?;
+        let mut r = vec![None; found.len()];
+        for (m, &(_, p)) in found.into_iter().zip(&order) {
+            r[p as usize] = m;
+        }
+        Ok(r)
+    }
+
+    /// Starts loading the cells of the star `star_of(k + 2)`, and the centers and vertices
+    /// of `star_of(k + 1)` (whose cells were asked for one point ago): the cells are far
+    /// apart in memory, and these loads overlap the work on point `k` (a fifth of the time).
+    fn prefetch_stars<'a>(
+        &self,
+        center: &[[f64; D]],
+        star_of: impl Fn(usize) -> &'a [(CellId, u8)],
+        k: usize,
+    ) {
+        let e = self.engine();
+        let n = self.number_of_vertices();
+        if k + 2 < n {
+            for &(t, _) in star_of(k + 2) {
+                prefetch(e.cell(t));
+            }
+        }
+        if k + 1 < n {
+            for &(t, _) in star_of(k + 1) {
+                prefetch(&center[t.index()]);
+                for &v in &e.cell(t).v {
+                    prefetch(&e.points()[e.point_of(v).index()]);
+                }
+            }
+        }
+    }
+
+    /// The measures of point `p`'s cell from its `star` (cells and the point's slot in
+    /// each), or `None` next to two cells of one circumsphere.
+    fn pieces_of(
+        &self,
+        center: &[[f64; D]],
+        star: &[(CellId, u8)],
+        p: PointId,
+    ) -> Option<CellMeasures<D>> {
+        let e = self.engine();
+        let space = self.space();
+        let mut volume = 0.0;
+        let mut surface = 0.0;
+        let mut moment = [0.0; D];
+        for &(t, k) in star {
+            let k = k as usize;
+            let cell = e.cell(t);
+            let at = e.lifted(t, k);
+            // the cell's vertices and circumcenter in its frame, relative to the point
+            let rel: [[f64; D]; N] = std::array::from_fn(|a| {
+                if a == k {
+                    [0.0; D]
+                } else {
+                    space.lifted_difference(e.lifted(t, a), at)
+                }
+            });
+            let c = sub(
+                &center[t.index()],
+                &space.lifted_difference(at, e.lifted(t, 0)),
+            );
+            let extent2 = rel.iter().map(|r| dot(r, r)).fold(0.0, f64::max);
+            let mut piece_moment = [0.0; D];
+            for l in (0..N).filter(|&l| l != k) {
+                let d = cell.n[l];
+                if d < t {
+                    continue; // taken from `d`
+                }
+                // the neighbour's circumcenter, carried into this cell's frame
+                let g = e.translation(t, l, d);
+                let dc = e.cell(d);
+                let d0 = (
+                    e.points()[e.point_of(dc.v[0]).index()],
+                    space.compose(g, dc.off[0]),
+                );
+                let base = space.lifted_difference(d0, at);
+                let z = space.untwist(space.inverse(g), center[d.index()]);
+                let c2: [f64; D] = std::array::from_fn(|x| base[x] + z[x]);
+                if self.may_share_sphere(&c, &c2, extent2) && self.one_sphere(t, l, d) {
+                    return None;
+                }
+                for j in (0..N).filter(|&j| j != k && j != l) {
+                    let mut perm = [k, j, l, l];
+                    if N == 4 {
+                        perm[2] = 6 - k - j - l;
+                        perm[3] = l;
+                    }
+                    let s = parity(&perm[..N]);
+                    let b = &rel[j];
+                    let bb = dot(b, b);
+                    if N == 4 {
+                        // the foot of the bisector (power bisector) on the edge
+                        let lambda = if e.is_weighted() {
+                            let w = |a: usize| e.vertex_weight(cell.v[a]);
+                            0.5 + (w(k) - w(j)) / (2.0 * bb)
+                        } else {
+                            0.5
+                        };
+                        let m = b.map(|x| lambda * x);
+                        let x = cross(&sub(&c2, &m), &sub(&c, &m)).map(|x| s * x);
+                        let v = dot(&m, &x) / 6.0;
+                        volume += v;
+                        surface += 0.5 * dot(b, &x) / bb.sqrt();
+                        for a in 0..D {
+                            piece_moment[a] += v * (m[a] + c[a] + c2[a]) / 4.0;
+                        }
+                    } else {
+                        let v = 0.5 * s * (c2[0] * c[1] - c2[1] * c[0]);
+                        volume += v;
+                        surface += s * (b[0] * (c[1] - c2[1]) - b[1] * (c[0] - c2[0])) / bb.sqrt();
+                        for a in 0..D {
+                            piece_moment[a] += v * (c[a] + c2[a]) / 3.0;
+                        }
+                    }
+                }
+            }
+            let back = space.untwist(at.1, piece_moment);
+            for a in 0..D {
+                moment[a] += back[a];
+            }
+        }
+        // the link of a vertex is a triangulated sphere (a circle in 2D): 3D, `T` triangles
+        // have `T/2 + 2` vertices, one per Delaunay edge at the point
+        let faces = if N == 4 {
+            star.len() / 2 + 2
+        } else {
+            star.len()
+        };
+        let position = e.points()[p.index()];
+        let here = space.lifted_position((position, space.identity()));
+        Some(CellMeasures {
+            point: self.input_of_vertex(p),
+            volume: space.measure_to_user(volume, D as i32),
+            faces: faces as u32,
+            surface_area: space.measure_to_user(surface, D as i32 - 1),
+            centroid: space.to_user(std::array::from_fn(|a| here[a] + moment[a] / volume)),
+        })
+    }
+
+    /// False when the circumcenters `c` and `c2` of two cells of squared extent at least
+    /// `extent2` are too far apart for one sphere: each is certified to `2⁻³⁶` of its
+    /// magnitude and its cell's extent, and this allows `2⁻³⁰` of them.
+    fn may_share_sphere(&self, c: &[f64; D], c2: &[f64; D], extent2: f64) -> bool {
+        let d = sub(c, c2);
+        dot(&d, &d) <= (dot(c, c) + dot(c2, c2) + extent2) * 2f64.powi(-60)
+    }
+}
