@@ -668,8 +668,8 @@ fn voronoi_in<const D: usize, const N: usize, S: SpaceFormat<D, N>>(
     let (pts, weights) = read_input::<D>(input, &args.weighting)?;
     let (tri, cost) = build(space, &pts, weights.as_deref())?;
     // whole cells only when an output needs their geometry; tables need their measures
-    let whole =
-        matches!(format, VoronoiFormat::Json | VoronoiFormat::Vtu) || args.neighbours.is_some();
+    // (and the neighbour pairs their faces' areas)
+    let whole = matches!(format, VoronoiFormat::Json | VoronoiFormat::Vtu);
     let start = Instant::now();
     // the Voronoi phase polls after about the same work each time: one step of the bar
     let n = tri.number_of_vertices();
@@ -685,10 +685,19 @@ fn voronoi_in<const D: usize, const N: usize, S: SpaceFormat<D, N>>(
     } else {
         Vec::new()
     };
-    let measures: Vec<orbitri::CellMeasures<D>> = if whole {
-        cells.iter().map(orbitri::CellMeasures::from).collect()
+    let (measures, pairs) = if whole {
+        let pairs = match args.neighbours {
+            Some(_) => tri.voronoi_neighbors_of(&cells),
+            None => Vec::new(),
+        };
+        (
+            cells.iter().map(orbitri::CellMeasures::from).collect(),
+            pairs,
+        )
+    } else if args.neighbours.is_some() {
+        tri.voronoi_measures_and_neighbors_until(&tick)?
     } else {
-        tri.voronoi_measures_until(&tick)?
+        (tri.voronoi_measures_until(&tick)?, Vec::new())
     };
     if let Some(b) = bar {
         b.finish_and_clear();
@@ -703,7 +712,7 @@ fn voronoi_in<const D: usize, const N: usize, S: SpaceFormat<D, N>>(
     })?;
     if args.neighbours.is_some() {
         write_with(&args.neighbours, |w| {
-            orbitri::io::write_neighbors_csv(w, &tri, &cells)
+            orbitri::io::write_neighbors_csv::<D, N, S>(w, &pairs)
         })?;
     }
     if args.edges.is_some() {

@@ -50,4 +50,4 @@ pub use triangulation::{
     ManifoldTriangulation3, PeriodicDelaunay, PeriodicDelaunay2, PeriodicDelaunay3, Simplex,
     Triangulation,
 };
-pub use voronoi::{CellMeasures, Neighbor, VoronoiCell, VoronoiFace};
+pub use voronoi::{CellMeasures, MeasuresAndNeighbors, Neighbor, VoronoiCell, VoronoiFace};

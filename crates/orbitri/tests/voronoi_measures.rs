@@ -21,14 +21,40 @@ fn same_measures<const D: usize, const N: usize, S: FlatSpace<D, N>>(
     tri: &Triangulation<D, N, S>,
     volume: f64,
     what: &str,
-) {
+) where
+    S::Elem: Ord + std::fmt::Debug,
+{
     assert_eq!(
         tri.engine().sheets(),
         1,
         "{what}: by pieces only when 1-sheeted"
     );
     let measures = tri.voronoi_measures();
-    let cells: Vec<CellMeasures<D>> = tri.voronoi_cells().iter().map(CellMeasures::from).collect();
+    let whole = tri.voronoi_cells();
+    let cells: Vec<CellMeasures<D>> = whole.iter().map(CellMeasures::from).collect();
+    // the neighbour pairs too: the same pairs (in 3D in the same order), the same areas
+    let (with_pairs, mut pairs) = tri.voronoi_measures_and_neighbors_until(&|| false).unwrap();
+    assert_eq!(with_pairs, measures, "{what}");
+    assert_eq!(pairs, tri.voronoi_neighbors(), "{what}");
+    let mut expected = tri.voronoi_neighbors_of(&whole);
+    if D == 2 {
+        // (a 2D cell lists its faces counter-clockwise, the pairs by first appearance)
+        pairs.sort_by_key(|p| (p.i, p.j, p.shift));
+        expected.sort_by_key(|p| (p.i, p.j, p.shift));
+    }
+    assert_eq!(pairs.len(), expected.len(), "{what}");
+    for (a, b) in pairs.iter().zip(&expected) {
+        assert_eq!((a.i, a.j, a.shift), (b.i, b.j, b.shift), "{what}");
+        let scale = (volume / cells.len() as f64).powf((D as f64 - 1.0) / D as f64);
+        assert!(
+            (a.area - b.area).abs() <= 1e-9 * scale.max(b.area),
+            "{what}: face {:?}–{:?}: {} against {}",
+            a.i,
+            a.j,
+            a.area,
+            b.area
+        );
+    }
     assert_eq!(measures.len(), cells.len(), "{what}");
     let mut total = 0.0;
     for (m, c) in measures.iter().zip(&cells) {

@@ -12,7 +12,7 @@ use super::write::{json_f64, json_point};
 use crate::ids::InputId;
 use crate::space::FlatSpace;
 use crate::triangulation::Triangulation;
-use crate::voronoi::{CellMeasures, VoronoiCell};
+use crate::voronoi::{CellMeasures, Neighbor, VoronoiCell};
 
 const AXES: [&str; 3] = ["x", "y", "z"];
 
@@ -132,18 +132,14 @@ impl PointTable {
     }
 }
 
-/// The Voronoi neighbour pairs of `cells` (as [`Triangulation::voronoi_cells`] gives them)
-/// as CSV, each pair of images once: `i,j,ELEMENT…,area`, the element's columns as
+/// The Voronoi neighbour pairs (as [`Triangulation::voronoi_neighbors`] gives them, each
+/// pair of images once) as CSV: `i,j,ELEMENT…,area`, the element's columns as
 /// [`SpaceFormat::element_columns`] names them (a torus's `shift_x,shift_y[,shift_z]`).
 pub fn write_neighbors_csv<const D: usize, const N: usize, S: SpaceFormat<D, N>>(
     w: &mut impl Write,
-    tri: &Triangulation<D, N, S>,
-    cells: &[VoronoiCell<D, S::Elem>],
+    pairs: &[Neighbor<D, S::Elem>],
 ) -> std::io::Result<()> {
-    let rows = tri
-        .voronoi_neighbors_of(cells)
-        .into_iter()
-        .map(|p| (p.i, p.j, p.shift, p.area));
+    let rows = pairs.iter().map(|p| (p.i, p.j, p.shift, p.area));
     write_pairs_csv::<D, N, S>(w, "area", rows)
 }
 

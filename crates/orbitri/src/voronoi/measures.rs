@@ -11,12 +11,77 @@
 
 use rayon::prelude::*;
 
-use super::{cross, dot, CellMeasures, POINTS_PER_POLL};
+use super::{cross, dot, CellMeasures, Neighbor, POINTS_PER_POLL};
 use crate::error::{Error, Result};
-use crate::ids::{CellId, PointId};
+use crate::ids::{CellId, PointId, VertexId};
 use crate::space::FlatSpace;
 use crate::tds::prefetch;
 use crate::triangulation::Triangulation;
+
+/// A point's cell measures and its neighbour pairs (each unordered pair once: those where
+/// it is `i`).
+pub(super) type Measured<const D: usize, E> = (CellMeasures<D>, Vec<Neighbor<D, E>>);
+
+/// The faces of one cell, gathered while its pieces are summed (buffers reused from point
+/// to point).
+struct Faces<E, const N: usize> {
+    /// Each Delaunay edge at the point (the far vertex, its element relative to the point)
+    /// and the area of its face so far, in the order of first appearance in the star.
+    edges: Vec<(VertexId, E, f64)>,
+    /// `index[u][j]`: the edge from the point to slot `j` of the star's cell `u`.
+    index: Vec<[u32; N]>,
+    /// Open addressing on the far vertex: an edge's position, or `u32::MAX`.
+    table: Vec<u32>,
+}
+
+impl<E, const N: usize> Default for Faces<E, N> {
+    fn default() -> Self {
+        Faces {
+            edges: Vec::new(),
+            index: Vec::new(),
+            table: Vec::new(),
+        }
+    }
+}
+
+impl<E: Copy + PartialEq, const N: usize> Faces<E, N> {
+    /// Lists the Delaunay edges of a `star` (`edge(cell, k, j)`: from the point at slot `k`
+    /// to slot `j`), in the order of first appearance, each found again by hashing.
+    fn gather(
+        &mut self,
+        star: &[(CellId, u8)],
+        edge: impl Fn(CellId, usize, usize) -> (VertexId, E),
+    ) {
+        self.edges.clear();
+        self.index.clear();
+        // (at most N − 1 edges a cell: the table stays at most half full)
+        let size = (2 * (N - 1) * star.len()).next_power_of_two();
+        self.table.clear();
+        self.table.resize(size, u32::MAX);
+        for &(t, k) in star {
+            let k = k as usize;
+            let mut at = [0u32; N];
+            for j in (0..N).filter(|&j| j != k) {
+                let (v, g) = edge(t, k, j);
+                let mut h = (v.0.wrapping_mul(0x9E37_79B1) >> 7) as usize & (size - 1);
+                at[j] = loop {
+                    let f = self.table[h];
+                    if f == u32::MAX {
+                        self.table[h] = self.edges.len() as u32;
+                        self.edges.push((v, g, 0.0));
+                        break self.table[h];
+                    }
+                    let x = &self.edges[f as usize];
+                    if (x.0, x.1) == (v, g) {
+                        break f;
+                    }
+                    h = (h + 1) & (size - 1);
+                };
+            }
+            self.index.push(at);
+        }
+    }
+}
 
 /// `+1.0` for an even permutation of `0..len`, `-1.0` for an odd one.
 fn parity(perm: &[usize]) -> f64 {
@@ -45,7 +110,8 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     pub(super) fn measures_by_pieces(
         &self,
         interrupt: &(dyn Fn() -> bool + Sync),
-    ) -> Result<Vec<Option<CellMeasures<D>>>> {
+        pairs: bool,
+    ) -> Result<Vec<Option<Measured<D, S::Elem>>>> {
         debug_assert_eq!(self.engine().sheets(), 1);
         if interrupt() {
             return Err(Error::Interrupted);
@@ -67,14 +133,16 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             .collect();
         order.par_sort_unstable();
         let star_of = |k: usize| stars.of(e.vertex_of_point(PointId(order[k].1)));
-        let found: Vec<Option<CellMeasures<D>>> = (0..order.len())
+        let found: Vec<Option<Measured<D, S::Elem>>> = (0..order.len())
             .into_par_iter()
-            .map(|k| {
+            .map_init(Faces::default, |faces, k| {
                 if k % POINTS_PER_POLL == 0 && interrupt() {
                     return Err(Error::Interrupted);
                 }
                 self.prefetch_stars(&center, star_of, k);
-                Ok(self.pieces_of(&center, star_of(k), PointId(order[k].1)))
+                let p = PointId(order[k].1);
+                let faces = pairs.then_some(faces);
+                Ok(self.pieces_of(&center, star_of(k), p, faces))
             })
             .collect::<Result<_>>()?;
         let mut r = vec![None; found.len()];
@@ -111,19 +179,28 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     }
 
     /// The measures of point `p`'s cell from its `star` (cells and the point's slot in
-    /// each), or `None` next to two cells of one circumsphere.
+    /// each), and with `faces` (buffers) its neighbour pairs; `None` next to two cells of
+    /// one circumsphere.
     fn pieces_of(
         &self,
         center: &[[f64; D]],
         star: &[(CellId, u8)],
         p: PointId,
-    ) -> Option<CellMeasures<D>> {
+        mut faces: Option<&mut Faces<S::Elem, N>>,
+    ) -> Option<Measured<D, S::Elem>> {
         let e = self.engine();
         let space = self.space();
+        if let Some(faces) = faces.as_deref_mut() {
+            // the faces in the order the whole cell lists them: by first appearance in the star
+            faces.gather(star, |t, k, j| {
+                let cell = e.cell(t);
+                (cell.v[j], space.relative(cell.off[j], cell.off[k]))
+            });
+        }
         let mut volume = 0.0;
         let mut surface = 0.0;
         let mut moment = [0.0; D];
-        for &(t, k) in star {
+        for (u, &(t, k)) in star.iter().enumerate() {
             let k = k as usize;
             let cell = e.cell(t);
             let at = e.lifted(t, k);
@@ -168,6 +245,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
                     let s = parity(&perm[..N]);
                     let b = &rel[j];
                     let bb = dot(b, b);
+                    let area;
                     if N == 4 {
                         // the foot of the bisector (power bisector) on the edge
                         let lambda = if e.is_weighted() {
@@ -180,17 +258,21 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
                         let x = cross(&sub(&c2, &m), &sub(&c, &m)).map(|x| s * x);
                         let v = dot(&m, &x) / 6.0;
                         volume += v;
-                        surface += 0.5 * dot(b, &x) / bb.sqrt();
+                        area = 0.5 * dot(b, &x) / bb.sqrt();
                         for a in 0..D {
                             piece_moment[a] += v * (m[a] + c[a] + c2[a]) / 4.0;
                         }
                     } else {
                         let v = 0.5 * s * (c2[0] * c[1] - c2[1] * c[0]);
                         volume += v;
-                        surface += s * (b[0] * (c[1] - c2[1]) - b[1] * (c[0] - c2[0])) / bb.sqrt();
+                        area = s * (b[0] * (c[1] - c2[1]) - b[1] * (c[0] - c2[0])) / bb.sqrt();
                         for a in 0..D {
                             piece_moment[a] += v * (c[a] + c2[a]) / 3.0;
                         }
+                    }
+                    surface += area;
+                    if let Some(f) = faces.as_deref_mut() {
+                        f.edges[f.index[u][j] as usize].2 += area;
                     }
                 }
             }
@@ -201,20 +283,37 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         }
         // the link of a vertex is a triangulated sphere (a circle in 2D): 3D, `T` triangles
         // have `T/2 + 2` vertices, one per Delaunay edge at the point
-        let faces = if N == 4 {
+        let count = if N == 4 {
             star.len() / 2 + 2
         } else {
             star.len()
         };
         let position = e.points()[p.index()];
         let here = space.lifted_position((position, space.identity()));
-        Some(CellMeasures {
-            point: self.input_of_vertex(p),
+        let i = self.input_of_vertex(p);
+        // each unordered pair of images once, as `neighbor_pairs_by` lists them
+        let pairs = faces.map_or_else(Vec::new, |faces| {
+            faces
+                .edges
+                .iter()
+                .map(|&(w, g, area)| (self.input_of_vertex(e.point_of(w)), g, area))
+                .filter(|&(j, g, _)| i < j || (i == j && g > space.inverse(g)))
+                .map(|(j, shift, area)| Neighbor {
+                    i,
+                    j,
+                    shift,
+                    area: space.measure_to_user(area, D as i32 - 1),
+                })
+                .collect()
+        });
+        let measures = CellMeasures {
+            point: i,
             volume: space.measure_to_user(volume, D as i32),
-            faces: faces as u32,
+            faces: count as u32,
             surface_area: space.measure_to_user(surface, D as i32 - 1),
             centroid: space.to_user(std::array::from_fn(|a| here[a] + moment[a] / volume)),
-        })
+        };
+        Some((measures, pairs))
     }
 
     /// False when the circumcenters `c` and `c2` of two cells of squared extent at least

@@ -82,6 +82,9 @@ impl<const D: usize, E> From<&VoronoiCell<D, E>> for CellMeasures<D> {
     }
 }
 
+/// Every cell's measures (in the order of first occurrence) and the neighbour pairs.
+pub type MeasuresAndNeighbors<const D: usize, E> = (Vec<CellMeasures<D>>, Vec<Neighbor<D, E>>);
+
 /// Two Voronoi neighbours: `j`'s image `shift·points[j]` (in a torus `points[j] + shift·M`)
 /// shares a face of this area with `i`. Each unordered pair of images is listed once.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -244,12 +247,37 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         &self,
         interrupt: &(dyn Fn() -> bool + Sync),
     ) -> Result<Vec<CellMeasures<D>>> {
+        Ok(self.measures_until(interrupt, false)?.0)
+    }
+
+    /// The measures as [`Self::voronoi_measures_until`], and the neighbour pairs as
+    /// [`Self::voronoi_neighbors`] lists them, without building the cells (when 1-sheeted).
+    pub fn voronoi_measures_and_neighbors_until(
+        &self,
+        interrupt: &(dyn Fn() -> bool + Sync),
+    ) -> Result<MeasuresAndNeighbors<D, S::Elem>> {
+        self.measures_until(interrupt, true)
+    }
+
+    /// The measures, and with `pairs` the neighbour pairs: by pieces when 1-sheeted
+    /// (`measures.rs`), the few points next to two cells of one circumsphere from their
+    /// whole cells (not polled: degenerate inputs only); from the whole cells in a covering.
+    fn measures_until(
+        &self,
+        interrupt: &(dyn Fn() -> bool + Sync),
+        pairs: bool,
+    ) -> Result<MeasuresAndNeighbors<D, S::Elem>> {
+        let inverse = |g| self.space().inverse(g);
         if self.engine().sheets() > 1 {
-            return self.per_cell_until(|c| CellMeasures::from(&c), interrupt);
+            let cells = self.voronoi_cells_until(interrupt)?;
+            let found = if pairs {
+                neighbor_pairs_by(&cells, inverse)
+            } else {
+                Vec::new()
+            };
+            return Ok((cells.iter().map(CellMeasures::from).collect(), found));
         }
-        // by pieces, without the cells; the few points next to two cells of one
-        // circumsphere from their whole cells (not polled: degenerate inputs only)
-        let mut out = self.measures_by_pieces(interrupt)?;
+        let mut out = self.measures_by_pieces(interrupt, pairs)?;
         if out.iter().any(Option::is_none) {
             let duals = self.duals(&|| false)?;
             out.par_iter_mut()
@@ -257,10 +285,25 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
                 .filter(|(_, m)| m.is_none())
                 .for_each_init(CellScratch::default, |scratch, (p, m)| {
                     let cell = self.cell_of_point(&duals, PointId(p as u32), scratch);
-                    *m = Some(CellMeasures::from(&cell));
+                    let found = if pairs {
+                        neighbor_pairs_by(std::slice::from_ref(&cell), inverse)
+                    } else {
+                        Vec::new()
+                    };
+                    *m = Some((CellMeasures::from(&cell), found));
                 });
         }
-        Ok(self.in_input_order(out, |i| CellMeasures::from(&self.hidden_cell(i))))
+        let (measures, found): (Vec<_>, Vec<Vec<_>>) = self
+            .in_input_order(out, |i| {
+                (CellMeasures::from(&self.hidden_cell(i)), Vec::new())
+            })
+            .into_iter()
+            .unzip();
+        let mut all = Vec::with_capacity(found.iter().map(Vec::len).sum());
+        for f in found {
+            all.extend(f);
+        }
+        Ok((measures, all))
     }
 
     /// `f` of every cell, computed in parallel in point order (the spatially sorted
@@ -328,7 +371,9 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     /// images once (`i < j`, or `i == j` with the shift greater than its inverse: for a
     /// torus, its first non-zero entry positive).
     pub fn voronoi_neighbors(&self) -> Vec<Neighbor<D, S::Elem>> {
-        self.voronoi_neighbors_of(&self.voronoi_cells())
+        self.voronoi_measures_and_neighbors_until(&|| false)
+            .expect("never interrupted")
+            .1
     }
 
     /// The neighbour pairs of cells already computed (by [`Self::voronoi_cells`]), as
