@@ -11,9 +11,9 @@
 
 use rayon::prelude::*;
 
-use super::{cross, dot, CellMeasures, Neighbor, POINTS_PER_POLL};
+use super::{cross, dot, listed_once, CellMeasures, Faces, Neighbor, Stars, POINTS_PER_POLL};
 use crate::error::{Error, Result};
-use crate::ids::{CellId, PointId, VertexId};
+use crate::ids::{CellId, PointId};
 use crate::space::FlatSpace;
 use crate::tds::prefetch;
 use crate::triangulation::Triangulation;
@@ -21,67 +21,6 @@ use crate::triangulation::Triangulation;
 /// A point's cell measures and its neighbour pairs (each unordered pair once: those where
 /// it is `i`).
 pub(super) type Measured<const D: usize, E> = (CellMeasures<D>, Vec<Neighbor<D, E>>);
-
-/// The faces of one cell, gathered while its pieces are summed (buffers reused from point
-/// to point).
-struct Faces<E, const N: usize> {
-    /// Each Delaunay edge at the point (the far vertex, its element relative to the point)
-    /// and the area of its face so far, in the order of first appearance in the star.
-    edges: Vec<(VertexId, E, f64)>,
-    /// `index[u][j]`: the edge from the point to slot `j` of the star's cell `u`.
-    index: Vec<[u32; N]>,
-    /// Open addressing on the far vertex: an edge's position, or `u32::MAX`.
-    table: Vec<u32>,
-}
-
-impl<E, const N: usize> Default for Faces<E, N> {
-    fn default() -> Self {
-        Faces {
-            edges: Vec::new(),
-            index: Vec::new(),
-            table: Vec::new(),
-        }
-    }
-}
-
-impl<E: Copy + PartialEq, const N: usize> Faces<E, N> {
-    /// Lists the Delaunay edges of a `star` (`edge(cell, k, j)`: from the point at slot `k`
-    /// to slot `j`), in the order of first appearance, each found again by hashing.
-    fn gather(
-        &mut self,
-        star: &[(CellId, u8)],
-        edge: impl Fn(CellId, usize, usize) -> (VertexId, E),
-    ) {
-        self.edges.clear();
-        self.index.clear();
-        // (at most N − 1 edges a cell: the table stays at most half full)
-        let size = (2 * (N - 1) * star.len()).next_power_of_two();
-        self.table.clear();
-        self.table.resize(size, u32::MAX);
-        for &(t, k) in star {
-            let k = k as usize;
-            let mut at = [0u32; N];
-            for j in (0..N).filter(|&j| j != k) {
-                let (v, g) = edge(t, k, j);
-                let mut h = (v.0.wrapping_mul(0x9E37_79B1) >> 7) as usize & (size - 1);
-                at[j] = loop {
-                    let f = self.table[h];
-                    if f == u32::MAX {
-                        self.table[h] = self.edges.len() as u32;
-                        self.edges.push((v, g, 0.0));
-                        break self.table[h];
-                    }
-                    let x = &self.edges[f as usize];
-                    if (x.0, x.1) == (v, g) {
-                        break f;
-                    }
-                    h = (h + 1) & (size - 1);
-                };
-            }
-            self.index.push(at);
-        }
-    }
-}
 
 /// `+1.0` for an even permutation of `0..len`, `-1.0` for an odd one.
 fn parity(perm: &[usize]) -> f64 {
@@ -103,25 +42,19 @@ fn sub<const D: usize>(a: &[f64; D], b: &[f64; D]) -> [f64; D] {
 }
 
 impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> {
-    /// The measures of every point's cell by pieces (see the module), indexed by point;
-    /// `None` for a point with a facet between two cells of one circumsphere (one Voronoi
-    /// vertex: which of its edges keep a face is counted on the whole cell). 1-sheeted only.
-    /// Polls `interrupt` as [`Self::voronoi_polls`] counts.
+    /// The measures of every point's cell by pieces (see the module) from the cells'
+    /// circumcenters and the vertices' stars, indexed by point; `None` for a point with a
+    /// facet between two cells of one circumsphere (one Voronoi vertex: which of its edges
+    /// keep a face is counted on the whole cell). 1-sheeted only. Polls `interrupt` every
+    /// `POINTS_PER_POLL` points.
     pub(super) fn measures_by_pieces(
         &self,
+        center: &[[f64; D]],
+        stars: &Stars,
         interrupt: &(dyn Fn() -> bool + Sync),
         pairs: bool,
     ) -> Result<Vec<Option<Measured<D, S::Elem>>>> {
         debug_assert_eq!(self.engine().sheets(), 1);
-        if interrupt() {
-            return Err(Error::Interrupted);
-        }
-        let ids: Vec<CellId> = self.engine().cell_ids().collect();
-        let center = self.centers(&ids, interrupt)?;
-        if interrupt() {
-            return Err(Error::Interrupted);
-        }
-        let stars = self.stars(&ids, interrupt)?;
         // the points along the curve, not in insertion order: the next point's cells are
         // mostly the last one's, still in cache (a sixth of the time)
         let e = self.engine();
@@ -139,10 +72,10 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
                 if k % POINTS_PER_POLL == 0 && interrupt() {
                     return Err(Error::Interrupted);
                 }
-                self.prefetch_stars(&center, star_of, k);
+                self.prefetch_stars(center, star_of, k);
                 let p = PointId(order[k].1);
                 let faces = pairs.then_some(faces);
-                Ok(self.pieces_of(&center, star_of(k), p, faces))
+                Ok(self.pieces_of(center, star_of(k), p, faces))
             })
             .collect::<Result<_>>()?;
         let mut r = vec![None; found.len()];
@@ -192,10 +125,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         let space = self.space();
         if let Some(faces) = faces.as_deref_mut() {
             // the faces in the order the whole cell lists them: by first appearance in the star
-            faces.gather(star, |t, k, j| {
-                let cell = e.cell(t);
-                (cell.v[j], space.relative(cell.off[j], cell.off[k]))
-            });
+            faces.gather(star, |t, k, j| self.edge_at(t, k, j));
         }
         let mut volume = 0.0;
         let mut surface = 0.0;
@@ -233,16 +163,15 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
                 let base = space.lifted_difference(d0, at);
                 let z = space.untwist(space.inverse(g), center[d.index()]);
                 let c2: [f64; D] = std::array::from_fn(|x| base[x] + z[x]);
-                if self.may_share_sphere(&c, &c2, extent2) && self.one_sphere(t, l, d) {
+                if may_share_sphere(&c, &c2, extent2) && self.one_sphere(t, l, d) {
                     return None;
                 }
                 for j in (0..N).filter(|&j| j != k && j != l) {
-                    let mut perm = [k, j, l, l];
-                    if N == 4 {
-                        perm[2] = 6 - k - j - l;
-                        perm[3] = l;
-                    }
-                    let s = parity(&perm[..N]);
+                    let s = if N == 4 {
+                        parity(&[k, j, 6 - k - j - l, l])
+                    } else {
+                        parity(&[k, j, l])
+                    };
                     let b = &rel[j];
                     let bb = dot(b, b);
                     let area;
@@ -297,7 +226,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
                 .edges
                 .iter()
                 .map(|&(w, g, area)| (self.input_of_vertex(e.point_of(w)), g, area))
-                .filter(|&(j, g, _)| i < j || (i == j && g > space.inverse(g)))
+                .filter(|&(j, g, _)| listed_once(i, j, g, |g| space.inverse(g)))
                 .map(|(j, shift, area)| Neighbor {
                     i,
                     j,
@@ -315,12 +244,12 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         };
         Some((measures, pairs))
     }
+}
 
-    /// False when the circumcenters `c` and `c2` of two cells of squared extent at least
-    /// `extent2` are too far apart for one sphere: each is certified to `2⁻³⁶` of its
-    /// magnitude and its cell's extent, and this allows `2⁻³⁰` of them.
-    fn may_share_sphere(&self, c: &[f64; D], c2: &[f64; D], extent2: f64) -> bool {
-        let d = sub(c, c2);
-        dot(&d, &d) <= (dot(c, c) + dot(c2, c2) + extent2) * 2f64.powi(-60)
-    }
+/// False when the circumcenters `c` and `c2` of two cells of squared extent at least
+/// `extent2` are too far apart for one sphere: each is certified to `2⁻³⁶` of its magnitude
+/// and its cell's extent, and this allows `2⁻³⁰` of them.
+fn may_share_sphere<const D: usize>(c: &[f64; D], c2: &[f64; D], extent2: f64) -> bool {
+    let d = sub(c, c2);
+    dot(&d, &d) <= (dot(c, c) + dot(c2, c2) + extent2) * 2f64.powi(-60)
 }

@@ -121,26 +121,87 @@ fn newell<const D: usize>(vertices: &[[f64; D]], ids: &[u32]) -> [f64; 3] {
     n
 }
 
+/// The Delaunay edges at a point, each the dual of a face of its cell, in the order of
+/// first appearance in its star (buffers reused from point to point).
+struct Faces<E, const N: usize> {
+    /// Each Delaunay edge at the point (the far vertex, its element relative to the point)
+    /// and the area of its face so far (summed by pieces), in order of first appearance.
+    edges: Vec<(VertexId, E, f64)>,
+    /// `index[u][j]`: the edge from the point to slot `j` of the star's cell `u`.
+    index: Vec<[u32; N]>,
+    /// Open addressing on the far vertex: an edge's position, or `u32::MAX`.
+    table: Vec<u32>,
+}
+
+impl<E, const N: usize> Default for Faces<E, N> {
+    fn default() -> Self {
+        Faces {
+            edges: Vec::new(),
+            index: Vec::new(),
+            table: Vec::new(),
+        }
+    }
+}
+
+impl<E: Copy + PartialEq, const N: usize> Faces<E, N> {
+    /// Lists the Delaunay edges of a `star` (`edge(cell, k, j)`: from the point at slot `k`
+    /// to slot `j`), in the order of first appearance, each found again by hashing.
+    fn gather(
+        &mut self,
+        star: &[(CellId, u8)],
+        edge: impl Fn(CellId, usize, usize) -> (VertexId, E),
+    ) {
+        self.edges.clear();
+        self.index.clear();
+        // (at most N − 1 edges a cell: the table stays at most half full)
+        let size = (2 * (N - 1) * star.len()).next_power_of_two();
+        self.table.clear();
+        self.table.resize(size, u32::MAX);
+        for &(t, k) in star {
+            let k = k as usize;
+            let mut at = [0u32; N];
+            for j in (0..N).filter(|&j| j != k) {
+                let (v, g) = edge(t, k, j);
+                let mut h = (v.0.wrapping_mul(0x9E37_79B1) >> 7) as usize & (size - 1);
+                at[j] = loop {
+                    let f = self.table[h];
+                    if f == u32::MAX {
+                        self.table[h] = self.edges.len() as u32;
+                        self.edges.push((v, g, 0.0));
+                        break self.table[h];
+                    }
+                    let x = &self.edges[f as usize];
+                    if (x.0, x.1) == (v, g) {
+                        break f;
+                    }
+                    h = (h + 1) & (size - 1);
+                };
+            }
+            self.index.push(at);
+        }
+    }
+}
+
 /// The buffers of [`Triangulation::cell_of_point`], reused from cell to cell by one worker
 /// (a cell needed some sixty small allocations: a tenth of the Voronoi pass in malloc).
-pub(crate) struct CellScratch<E> {
+pub(crate) struct CellScratch<E, const N: usize> {
     parent: Vec<usize>,
     vertex_of_root: Vec<u32>,
     vertex_of: Vec<u32>,
-    edges: Vec<(VertexId, E)>,
+    faces: Faces<E, N>,
     member: Vec<(u32, u32)>,
     ring: Vec<usize>,
     cycle: Vec<usize>,
 }
 
 // (not derived: that would ask the group elements for a `Default`)
-impl<E> Default for CellScratch<E> {
+impl<E, const N: usize> Default for CellScratch<E, N> {
     fn default() -> Self {
         CellScratch {
             parent: Vec::new(),
             vertex_of_root: Vec::new(),
             vertex_of: Vec::new(),
-            edges: Vec::new(),
+            faces: Faces::default(),
             member: Vec::new(),
             ring: Vec::new(),
             cycle: Vec::new(),
@@ -260,8 +321,9 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     }
 
     /// The measures, and with `pairs` the neighbour pairs: by pieces when 1-sheeted
-    /// (`measures.rs`), the few points next to two cells of one circumsphere from their
-    /// whole cells (not polled: degenerate inputs only); from the whole cells in a covering.
+    /// (`measures.rs`, from the circumcenters and stars computed here), the few points next
+    /// to two cells of one circumsphere from their whole cells (the same circumcenters and
+    /// stars); from the whole cells in a covering.
     fn measures_until(
         &self,
         interrupt: &(dyn Fn() -> bool + Sync),
@@ -277,9 +339,24 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             };
             return Ok((cells.iter().map(CellMeasures::from).collect(), found));
         }
-        let mut out = self.measures_by_pieces(interrupt, pairs)?;
+        if interrupt() {
+            return Err(Error::Interrupted);
+        }
+        let ids: Vec<CellId> = self.engine().cell_ids().collect();
+        let center = self.centers(&ids, interrupt)?;
+        if interrupt() {
+            return Err(Error::Interrupted);
+        }
+        let stars = self.stars(&ids, interrupt)?;
+        let mut out = self.measures_by_pieces(&center, &stars, interrupt, pairs)?;
         if out.iter().any(Option::is_none) {
-            let duals = self.duals(&|| false)?;
+            // (not polled: degenerate inputs only)
+            let cospherical = self.cospherical(&ids, center.len(), &|| false)?;
+            let duals = Duals {
+                center,
+                cospherical,
+                stars,
+            };
             out.par_iter_mut()
                 .enumerate()
                 .filter(|(_, m)| m.is_none())
@@ -387,13 +464,30 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
 
     /// The shared duals, polling `interrupt` every `CELLS_PER_POLL` cells, twice.
     fn duals(&self, interrupt: &(dyn Fn() -> bool + Sync)) -> Result<Duals<D>> {
-        let e = self.engine();
-        let ids: Vec<CellId> = e.cell_ids().collect();
+        let ids: Vec<CellId> = self.engine().cell_ids().collect();
         let center = self.centers(&ids, interrupt)?;
         if interrupt() {
             return Err(Error::Interrupted);
         }
-        // adjacent cells with one circumsphere: decided exactly, each facet once
+        let cospherical = self.cospherical(&ids, center.len(), interrupt)?;
+        let stars = self.stars(&ids, &|| false)?;
+        Ok(Duals {
+            center,
+            cospherical,
+            stars,
+        })
+    }
+
+    /// Bit `x` of entry `c`: cell `c` and its neighbour across facet `x` have one
+    /// circumsphere (decided exactly, each facet once), for the cells `ids` (`slots` entries,
+    /// indexed by cell id), polling `interrupt` every `CELLS_PER_POLL` cells.
+    fn cospherical(
+        &self,
+        ids: &[CellId],
+        slots: usize,
+        interrupt: &(dyn Fn() -> bool + Sync),
+    ) -> Result<Vec<u8>> {
+        let e = self.engine();
         let stopped = std::sync::atomic::AtomicBool::new(false);
         let merges: Vec<(CellId, usize, CellId)> = ids
             .par_iter()
@@ -412,18 +506,13 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         if stopped.into_inner() {
             return Err(Error::Interrupted);
         }
-        let mut cospherical = vec![0u8; center.len()];
+        let mut cospherical = vec![0u8; slots];
         for (c, x, d) in merges {
             let y = e.cell(d).mirror(c).expect("symmetric neighbours");
             cospherical[c.index()] |= 1 << x;
             cospherical[d.index()] |= 1 << y;
         }
-        let stars = self.stars(&ids, &|| false)?;
-        Ok(Duals {
-            center,
-            cospherical,
-            stars,
-        })
+        Ok(cospherical)
     }
 
     /// Each stored cell's circumcenter (orthocenter), indexed by cell id, polling
@@ -508,13 +597,13 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         &self,
         duals: &Duals<D>,
         p: PointId,
-        scratch: &mut CellScratch<S::Elem>,
+        scratch: &mut CellScratch<S::Elem, N>,
     ) -> VoronoiCell<D, S::Elem> {
         let CellScratch {
             parent,
             vertex_of_root,
             vertex_of,
-            edges,
+            faces: edges,
             member,
             ring,
             cycle,
@@ -561,23 +650,16 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             vertex_of_root[r]
         }));
         // faces: the ring of star cells around each Delaunay edge at the point
-        edges.clear();
+        edges.gather(star, |c, k, j| self.edge_at(c, k, j));
         member.clear();
-        for (s, &(c, k)) in star.iter().enumerate() {
-            let cell = e.cell(c);
-            for j in (0..N).filter(|&j| j != k as usize) {
-                let key = (cell.v[j], space.relative(cell.off[j], cell.off[k as usize]));
-                let f = edges.iter().position(|x| *x == key).unwrap_or_else(|| {
-                    edges.push(key);
-                    edges.len() - 1
-                });
-                member.push((f as u32, s as u32));
-            }
+        for (s, at) in edges.index.iter().enumerate() {
+            let k = star[s].1 as usize;
+            member.extend((0..N).filter(|&j| j != k).map(|j| (at[j], s as u32)));
         }
         member.sort_unstable();
-        let mut faces = Vec::with_capacity(edges.len());
+        let mut faces = Vec::with_capacity(edges.edges.len());
         for (f, members) in member.chunk_by(|a, b| a.0 == b.0).enumerate() {
-            let (w, r) = edges[f];
+            let (w, r, _) = edges.edges[f];
             ring.clear();
             ring.extend(members.iter().map(|m| m.1 as usize));
             self.ring_cycle(star, ring, (w, r), cycle);
@@ -635,6 +717,13 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         }
     }
 
+    /// The Delaunay edge of cell `c` from its slot `k` to its slot `j`: the far vertex and
+    /// its element relative to the near one's.
+    fn edge_at(&self, c: CellId, k: usize, j: usize) -> (VertexId, S::Elem) {
+        let cell = self.engine().cell(c);
+        (cell.v[j], self.space().relative(cell.off[j], cell.off[k]))
+    }
+
     /// The star cells around the Delaunay edge from the point to `(w, r)`, in cyclic order:
     /// consecutive cells share a facet holding both ends of the edge.
     fn ring_cycle(
@@ -653,9 +742,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             let k = k as usize;
             let cell = e.cell(c);
             let j = (0..N)
-                .find(|&j| {
-                    j != k && cell.v[j] == w && e.space().relative(cell.off[j], cell.off[k]) == r
-                })
+                .find(|&j| j != k && self.edge_at(c, k, j) == (w, r))
                 .expect("the ring cell holds the edge");
             let next = (0..N)
                 .filter(|&x| x != k && x != j)
@@ -786,9 +873,7 @@ pub fn neighbor_pairs_by<const D: usize, E: Copy + Ord>(
         .flat_map(|c| {
             c.faces
                 .iter()
-                .filter(|f| {
-                    c.point < f.neighbor || (c.point == f.neighbor && f.shift > inverse(f.shift))
-                })
+                .filter(|f| listed_once(c.point, f.neighbor, f.shift, &inverse))
                 .map(move |f| Neighbor {
                     i: c.point,
                     j: f.neighbor,
@@ -797,4 +882,10 @@ pub fn neighbor_pairs_by<const D: usize, E: Copy + Ord>(
                 })
         })
         .collect()
+}
+
+/// True for the one side of a face that lists it as a neighbour pair: `i < j`, or `i == j`
+/// with the element greater than its inverse.
+fn listed_once<E: Copy + Ord>(i: InputId, j: InputId, g: E, inverse: impl Fn(E) -> E) -> bool {
+    i < j || (i == j && g > inverse(g))
 }
