@@ -51,8 +51,6 @@ const MARGIN: usize = 64;
 /// others walk from the chunk's last insertion): walks that keep failing, from cells of the
 /// chunk cut off by others', start afresh there.
 const STRIDE: usize = 64;
-/// An owner that no pass has written.
-const FREE: u32 = u32::MAX;
 
 /// One point to insert: a tag for the caller, the point, its weight (ignored unless the
 /// triangulation is weighted) and its spatial key.
@@ -251,13 +249,9 @@ impl<O, const N: usize> Chunk<O, N> {
 /// The state kept across the waves of one parallel insertion.
 #[derive(Debug, Default)]
 struct Shared {
-    /// Per cell slot: `pass << 8 | chunk` of the pass that made the cell.
-    owner: Vec<AtomicU32>,
     /// Per point: its spatial key (stale for points renumbered by a hiding insertion, which
     /// only moves chunk borders).
     keys: Vec<u64>,
-    /// The current pass.
-    pass: u32,
 }
 
 impl Shared {
@@ -269,27 +263,17 @@ impl Shared {
         self.keys
             .extend(points[from..].iter().map(|p| space.spatial_key(p)));
     }
-
-    /// Starts a pass: its number (the owners of earlier passes forgotten when the numbers
-    /// run out).
-    fn next_pass(&mut self) -> u32 {
-        self.pass += 1;
-        if self.pass >= 1 << 24 {
-            self.owner.iter_mut().for_each(|o| *o.get_mut() = FREE);
-            self.pass = 1;
-        }
-        self.pass
-    }
 }
 
-/// Which chunk of the current pass owns a cell: the one that made it in this pass, else
-/// the one whose key range holds the key of its vertex 0.
-struct Ownership<'a> {
-    /// The first key of each chunk but the first.
-    bounds: Vec<u64>,
-    pass: u32,
-    owner: &'a [AtomicU32],
-    keys: &'a [u64],
+/// Which chunk of the current pass owns a cell, kept in the cell's stamp as `first +
+/// chunk` (read with the cell: no other memory to wait for): the one that made it in this
+/// pass, else the one whose key range holds the key of its vertex 0 (stamped before the
+/// pass).
+#[derive(Clone, Copy, Debug)]
+struct Ownership {
+    /// The stamp of chunk 0 (values that no visit takes, from
+    /// [`crate::tds::Tds::reserve_stamps`]).
+    first: u32,
 }
 
 /// The cell store, written by several chunks at once, each only in the cells it owns and
@@ -315,7 +299,7 @@ struct Pass<'a, S: OrbitSpace<N>, const N: usize> {
     engine: &'a Engine<S, N>,
     cells: SharedCells<S::Elem, N>,
     vcell: &'a [AtomicU32],
-    own: Ownership<'a>,
+    own: Ownership,
     wave: &'a [Item<S::Point>],
     /// The id of the wave's first point.
     base: usize,
@@ -347,7 +331,7 @@ impl<S: OrbitSpace<N>, const N: usize> Pass<'_, S, N> {
     /// # Safety
     /// The chunk is this thread's alone.
     unsafe fn run(&self, ch: &mut Chunk<S::Elem, N>) {
-        let stamp = self.own.pass << 8 | ch.id;
+        let stamp = self.own.first + ch.id;
         for s in ch.range.clone() {
             if ch.full {
                 break;
@@ -366,16 +350,7 @@ impl<S: OrbitSpace<N>, const N: usize> Pass<'_, S, N> {
                 Found::Region => {
                     let x = VertexId::new(self.base + s);
                     let e = self.engine;
-                    if commit(
-                        &e.space,
-                        e.level,
-                        &self.cells,
-                        self.vcell,
-                        stamp,
-                        &self.own,
-                        ch,
-                        x,
-                    ) {
+                    if commit(&e.space, e.level, &self.cells, self.vcell, stamp, ch, x) {
                         Outcome::New
                     } else {
                         ch.full = true;
@@ -476,7 +451,8 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 (k as u32, p, w, key)
             })
             .collect();
-        wave.sort_unstable_by_key(|&(k, .., key)| (key, k));
+        // (stable, so merging: a wave is one or two BRIO rounds, each already sorted)
+        wave.sort_by_key(|&(k, .., key)| (key, k));
         let base = self.points.len();
         shared.sync(&self.space, &self.points);
         for &(_, p, _, key) in &wave {
@@ -580,7 +556,6 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         outcome: &mut [Outcome],
     ) {
         let n = wave.len();
-        let pass = shared.next_pass();
         let count = CHUNKS.min(n.max(1));
         // cell slots for each chunk: free ones, then new ones (a vertex makes `2` more
         // triangles on a surface, some 6.8 more tetrahedra in a volume)
@@ -602,13 +577,22 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         }
         let dead = Cell::new([VertexId::NONE; N], [self.space.identity(); N]);
         self.tds.cells.resize(slots, dead);
-        shared.owner.resize_with(slots, || AtomicU32::new(FREE));
+        // every live cell stamped with its owner: the chunk whose keys hold its vertex 0's
         let own = Ownership {
-            bounds: (1..count).map(|j| wave[j * n / count].3).collect(),
-            pass,
-            owner: &shared.owner,
-            keys: &shared.keys,
+            first: self.tds.reserve_stamps(count as u32),
         };
+        let bounds: Vec<u64> = (1..count).map(|j| wave[j * n / count].3).collect();
+        let keys = &shared.keys;
+        self.tds
+            .cells
+            .par_iter_mut()
+            .with_min_len(4096)
+            .for_each(|c| {
+                if c.v[0] != VertexId::NONE {
+                    let key = keys[c.v[0].index()];
+                    c.set_stamp(own.first + bounds.partition_point(|&b| b <= key) as u32);
+                }
+            });
         chunks
             .par_iter_mut()
             .for_each(|ch| self.locate_starts(ch, wave, &own));
@@ -678,12 +662,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// The chunk that owns live cell `c` in the current pass.
     #[inline(always)]
     fn owner_of(&self, own: &Ownership, c: CellId) -> u32 {
-        let s = own.owner[c.index()].load(Relaxed);
-        if s >> 8 == own.pass {
-            return s & 0xff;
-        }
-        let v = self.tds.cells[c.index()].v[0];
-        own.bounds.partition_point(|&b| b <= own.keys[v.index()]) as u32
+        self.tds.cells[c.index()].stamp().wrapping_sub(own.first)
     }
 
     /// The probe of a chunk's next point: locates it (walking from the chunk's last
@@ -777,7 +756,6 @@ unsafe fn commit<S: OrbitSpace<N>, const N: usize>(
     cells: &SharedCells<S::Elem, N>,
     vcell: &[AtomicU32],
     stamp: u32,
-    own: &Ownership,
     ch: &mut Chunk<S::Elem, N>,
     x: VertexId,
 ) -> bool {
@@ -860,8 +838,9 @@ unsafe fn commit<S: OrbitSpace<N>, const N: usize>(
         }
     }
     for (k, cell) in new.iter().enumerate() {
-        *cells.get(ids[k]) = *cell;
-        own.owner[ids[k].index()].store(stamp, Relaxed);
+        let mut cell = *cell;
+        cell.set_stamp(stamp);
+        *cells.get(ids[k]) = cell;
         let (d, jd) = ch.across[k];
         (*cells.get(d)).n[jd as usize] = ids[k];
         for &v in &cell.v {
@@ -872,7 +851,6 @@ unsafe fn commit<S: OrbitSpace<N>, const N: usize>(
     }
     for &(spare, _) in ch.conflict.iter().skip(new.len()) {
         (*cells.get(spare)).v[0] = VertexId::NONE;
-        own.owner[spare.index()].store(stamp, Relaxed);
         ch.spare.push(spare);
     }
     let k = new[0].index_of(x).expect("new cells hold the new vertex");

@@ -40,6 +40,18 @@ impl<O: Copy, const N: usize> Cell<O, N> {
         self.off.swap(a, b);
     }
 
+    /// The cell's stamp: the mark of a visit, or during a parallel pass its owner.
+    #[inline]
+    pub fn stamp(&self) -> u32 {
+        self.stamp
+    }
+
+    /// Sets the cell's stamp.
+    #[inline]
+    pub fn set_stamp(&mut self, s: u32) {
+        self.stamp = s;
+    }
+
     /// Index of neighbour `c` in this cell.
     #[inline]
     pub fn mirror(&self, c: CellId) -> Option<usize> {
@@ -138,6 +150,18 @@ impl<O: Copy, const N: usize> Tds<O, N> {
         (self.generation - 1, self.generation)
     }
 
+    /// Reserves `k` stamp values that no later visit takes (the owners of a parallel pass)
+    /// and returns the first.
+    pub fn reserve_stamps(&mut self, k: u32) -> u32 {
+        if self.generation >= u32::MAX - 4 - k {
+            self.cells.iter_mut().for_each(|c| c.stamp = 0);
+            self.generation = 0;
+        }
+        let first = self.generation + 1;
+        self.generation += k;
+        first
+    }
+
     /// Asks the processor to start loading the neighbours of `c`: the conflict search and
     /// the walk visit them next, and overlapping their cache misses saves more than it costs.
     #[inline(always)]
@@ -197,6 +221,9 @@ mod tests {
         assert_eq!(t.cells[c.index()].index_of(VertexId(5)), Some(1));
         let (i, o) = t.new_visit();
         assert_ne!(i, o);
+        let first = t.reserve_stamps(8);
+        let (i2, o2) = t.new_visit();
+        assert!(first > o && first + 7 < i2.min(o2));
         t.set_stamp(b, i);
         assert_eq!(t.stamp(b), i);
         assert_eq!(t.cells[b.index()].mirror(CellId::NONE), Some(0));
