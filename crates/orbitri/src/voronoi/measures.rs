@@ -18,9 +18,41 @@ use crate::space::FlatSpace;
 use crate::tds::prefetch;
 use crate::triangulation::Triangulation;
 
-/// A point's cell measures and its neighbour pairs (each unordered pair once: those where
-/// it is `i`).
-pub(super) type Measured<const D: usize, E> = (CellMeasures<D>, Vec<Neighbor<D, E>>);
+/// Where a point's neighbour pairs go: the buffers of its faces, and its block's list.
+type PairsOut<'a, const D: usize, const N: usize, E> =
+    (&'a mut Faces<E, N>, &'a mut Vec<Neighbor<D, E>>);
+
+/// Points of the curve per block of the pieces' pass: each block lists its points' pairs in
+/// one buffer (no allocation per point).
+const BLOCK: usize = 2048;
+
+/// A block's points (their measures and the end of their pairs), and its pairs.
+type Block<const D: usize, E> = (Vec<(Option<CellMeasures<D>>, u32)>, Vec<Neighbor<D, E>>);
+
+/// The measures by pieces of every point (indexed by point; `None` for a point measured on
+/// its whole cell) and, when asked for, each point's neighbour pairs (those where it is
+/// `i`), kept by blocks of the curve.
+pub(super) struct Pieces<const D: usize, E> {
+    pub(super) measures: Vec<Option<CellMeasures<D>>>,
+    /// Per point: its block, and the range of its pairs there.
+    at: Vec<(u32, u32, u32)>,
+    blocks: Vec<Vec<Neighbor<D, E>>>,
+}
+
+impl<const D: usize, E> Pieces<D, E> {
+    /// The neighbour pairs of point `p` (empty unless asked for).
+    pub(super) fn pairs_of(&self, p: PointId) -> &[Neighbor<D, E>] {
+        match self.at.get(p.index()) {
+            Some(&(b, from, to)) => &self.blocks[b as usize][from as usize..to as usize],
+            None => &[],
+        }
+    }
+
+    /// The number of pairs.
+    pub(super) fn number_of_pairs(&self) -> usize {
+        self.blocks.iter().map(Vec::len).sum()
+    }
+}
 
 /// `+1.0` for an even permutation of `0..len`, `-1.0` for an odd one.
 fn parity(perm: &[usize]) -> f64 {
@@ -53,7 +85,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         stars: &Stars,
         interrupt: &(dyn Fn() -> bool + Sync),
         pairs: bool,
-    ) -> Result<Vec<Option<Measured<D, S::Elem>>>> {
+    ) -> Result<Pieces<D, S::Elem>> {
         debug_assert_eq!(self.engine().sheets(), 1);
         // the points along the curve, not in insertion order: the next point's cells are
         // mostly the last one's, still in cache (a sixth of the time)
@@ -66,23 +98,47 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             .collect();
         order.par_sort_unstable();
         let star_of = |k: usize| stars.of(e.vertex_of_point(PointId(order[k].1)));
-        let found: Vec<Option<Measured<D, S::Elem>>> = (0..order.len())
+        // per block: each point's measures and the end of its pairs, and the pairs
+        let found: Vec<Block<D, S::Elem>> = (0..order.len().div_ceil(BLOCK))
             .into_par_iter()
-            .map_init(Faces::default, |faces, k| {
-                if k % POINTS_PER_POLL == 0 && interrupt() {
-                    return Err(Error::Interrupted);
+            .map_init(Faces::default, |faces, b| {
+                let ks = b * BLOCK..((b + 1) * BLOCK).min(order.len());
+                let mut measured = Vec::with_capacity(ks.len());
+                let mut found = Vec::new();
+                for k in ks {
+                    if k % POINTS_PER_POLL == 0 && interrupt() {
+                        return Err(Error::Interrupted);
+                    }
+                    self.prefetch_stars(center, star_of, k);
+                    let p = PointId(order[k].1);
+                    let out = pairs.then_some((&mut *faces, &mut found));
+                    let m = self.pieces_of(center, star_of(k), p, out);
+                    measured.push((m, found.len() as u32));
                 }
-                self.prefetch_stars(center, star_of, k);
-                let p = PointId(order[k].1);
-                let faces = pairs.then_some(faces);
-                Ok(self.pieces_of(center, star_of(k), p, faces))
+                Ok((measured, found))
             })
             .collect::<Result<_>>()?;
-        let mut r = vec![None; found.len()];
-        for (m, &(_, p)) in found.into_iter().zip(&order) {
-            r[p as usize] = m;
+        let n = order.len();
+        let mut measures = vec![None; n];
+        let mut at = vec![(0, 0, 0); if pairs { n } else { 0 }];
+        let mut blocks = Vec::with_capacity(found.len());
+        for (b, (measured, list)) in found.into_iter().enumerate() {
+            let mut from = 0;
+            for (k, (m, to)) in measured.into_iter().enumerate() {
+                let p = order[b * BLOCK + k].1 as usize;
+                measures[p] = m;
+                if pairs {
+                    at[p] = (b as u32, from, to);
+                }
+                from = to;
+            }
+            blocks.push(list);
         }
-        Ok(r)
+        Ok(Pieces {
+            measures,
+            at,
+            blocks,
+        })
     }
 
     /// Starts loading the cells of the star `star_of(k + 2)`, and the centers and vertices
@@ -112,17 +168,18 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     }
 
     /// The measures of point `p`'s cell from its `star` (cells and the point's slot in
-    /// each), and with `faces` (buffers) its neighbour pairs; `None` next to two cells of
-    /// one circumsphere.
+    /// each); with `pairs` (buffers, and the list), its neighbour pairs are pushed on the
+    /// list. `None` next to two cells of one circumsphere (nothing pushed).
     fn pieces_of(
         &self,
         center: &[[f64; D]],
         star: &[(CellId, u8)],
         p: PointId,
-        mut faces: Option<&mut Faces<S::Elem, N>>,
-    ) -> Option<Measured<D, S::Elem>> {
+        pairs: Option<PairsOut<'_, D, N, S::Elem>>,
+    ) -> Option<CellMeasures<D>> {
         let e = self.engine();
         let space = self.space();
+        let (mut faces, list) = pairs.unzip();
         if let Some(faces) = faces.as_deref_mut() {
             // the faces in the order the whole cell lists them: by first appearance in the star
             faces.gather(star, |t, k, j| self.edge_at(t, k, j));
@@ -221,28 +278,28 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         let here = space.lifted_position((position, space.identity()));
         let i = self.input_of_vertex(p);
         // each unordered pair of images once, as `neighbor_pairs_by` lists them
-        let pairs = faces.map_or_else(Vec::new, |faces| {
-            faces
-                .edges
-                .iter()
-                .map(|&(w, g, area)| (self.input_of_vertex(e.point_of(w)), g, area))
-                .filter(|&(j, g, _)| listed_once(i, j, g, |g| space.inverse(g)))
-                .map(|(j, shift, area)| Neighbor {
-                    i,
-                    j,
-                    shift,
-                    area: space.measure_to_user(area, D as i32 - 1),
-                })
-                .collect()
-        });
-        let measures = CellMeasures {
+        if let (Some(faces), Some(list)) = (faces, list) {
+            list.extend(
+                faces
+                    .edges
+                    .iter()
+                    .map(|&(w, g, area)| (self.input_of_vertex(e.point_of(w)), g, area))
+                    .filter(|&(j, g, _)| listed_once(i, j, g, |g| space.inverse(g)))
+                    .map(|(j, shift, area)| Neighbor {
+                        i,
+                        j,
+                        shift,
+                        area: space.measure_to_user(area, D as i32 - 1),
+                    }),
+            );
+        }
+        Some(CellMeasures {
             point: i,
             volume: space.measure_to_user(volume, D as i32),
             faces: count as u32,
             surface_area: space.measure_to_user(surface, D as i32 - 1),
             centroid: space.to_user(std::array::from_fn(|a| here[a] + moment[a] / volume)),
-        };
-        Some((measures, pairs))
+        })
     }
 }
 

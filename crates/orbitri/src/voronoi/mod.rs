@@ -348,8 +348,10 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             return Err(Error::Interrupted);
         }
         let stars = self.stars(&ids, interrupt)?;
-        let mut out = self.measures_by_pieces(&center, &stars, interrupt, pairs)?;
-        if out.iter().any(Option::is_none) {
+        let mut pieces = self.measures_by_pieces(&center, &stars, interrupt, pairs)?;
+        // the few points next to two cells of one circumsphere, on their whole cells
+        let mut whole: Vec<(PointId, Vec<Neighbor<D, S::Elem>>)> = Vec::new();
+        if pieces.measures.iter().any(Option::is_none) {
             // (not polled: degenerate inputs only)
             let cospherical = self.cospherical(&ids, center.len(), &|| false)?;
             let duals = Duals {
@@ -357,28 +359,48 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
                 cospherical,
                 stars,
             };
-            out.par_iter_mut()
-                .enumerate()
-                .filter(|(_, m)| m.is_none())
-                .for_each_init(CellScratch::default, |scratch, (p, m)| {
-                    let cell = self.cell_of_point(&duals, PointId(p as u32), scratch);
+            let found: Vec<(PointId, CellMeasures<D>, Vec<_>)> = (0..pieces.measures.len())
+                .into_par_iter()
+                .filter(|&p| pieces.measures[p].is_none())
+                .map_init(CellScratch::default, |scratch, p| {
+                    let p = PointId(p as u32);
+                    let cell = self.cell_of_point(&duals, p, scratch);
                     let found = if pairs {
                         neighbor_pairs_by(std::slice::from_ref(&cell), inverse)
                     } else {
                         Vec::new()
                     };
-                    *m = Some((CellMeasures::from(&cell), found));
-                });
+                    (p, CellMeasures::from(&cell), found)
+                })
+                .collect();
+            for (p, m, found) in found {
+                pieces.measures[p.index()] = Some(m);
+                whole.push((p, found));
+            }
+        } else {
+            // (the duals' memory back before the pairs are gathered)
+            drop((center, stars));
         }
-        let (measures, found): (Vec<_>, Vec<Vec<_>>) = self
-            .in_input_order(out, |i| {
-                (CellMeasures::from(&self.hidden_cell(i)), Vec::new())
+        let order = self.input_order(pieces.measures.len());
+        let measures = order
+            .iter()
+            .map(|&(i, p)| match p {
+                PointId::NONE => CellMeasures::from(&self.hidden_cell(i)),
+                p => pieces.measures[p.index()].take().expect("each point once"),
             })
-            .into_iter()
-            .unzip();
-        let mut all = Vec::with_capacity(found.iter().map(Vec::len).sum());
-        for f in found {
-            all.extend(f);
+            .collect();
+        let mut all = Vec::new();
+        if pairs {
+            all.reserve_exact(
+                pieces.number_of_pairs() + whole.iter().map(|w| w.1.len()).sum::<usize>(),
+            );
+            for &(_, p) in order.iter().filter(|o| o.1 != PointId::NONE) {
+                all.extend_from_slice(pieces.pairs_of(p));
+                // (`whole` is in point order, as the filter above found them)
+                if let Ok(k) = whole.binary_search_by_key(&p, |w| w.0) {
+                    all.extend_from_slice(&whole[k].1);
+                }
+            }
         }
         Ok((measures, all))
     }
@@ -416,18 +438,24 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     /// The values of the points (`out`, indexed by point, each `Some`) and of the hidden
     /// inputs (`hidden`), in the order of first occurrence.
     fn in_input_order<T>(&self, mut out: Vec<Option<T>>, hidden: impl Fn(InputId) -> T) -> Vec<T> {
-        let mut order: Vec<(InputId, PointId)> = (0..out.len() as u32)
-            .map(|p| (self.input_of_vertex(PointId(p)), PointId(p)))
-            .chain(self.hidden().into_iter().map(|i| (i, PointId::NONE)))
-            .collect();
-        order.sort_unstable();
-        order
+        self.input_order(out.len())
             .iter()
             .map(|&(i, p)| match p {
                 PointId::NONE => hidden(i),
                 p => out[p.index()].take().expect("each point once"),
             })
             .collect()
+    }
+
+    /// The `points` points (with their input ids) and the hidden inputs (with
+    /// `PointId::NONE`), in the order of first occurrence.
+    fn input_order(&self, points: usize) -> Vec<(InputId, PointId)> {
+        let mut order: Vec<(InputId, PointId)> = (0..points as u32)
+            .map(|p| (self.input_of_vertex(PointId(p)), PointId(p)))
+            .chain(self.hidden().into_iter().map(|i| (i, PointId::NONE)))
+            .collect();
+        order.par_sort_unstable();
+        order
     }
 
     /// The empty power cell of hidden input `i`: no vertices or faces, volume 0, its
