@@ -1029,9 +1029,10 @@ class Voronoi:
     a picture (2D).
 
     The measures are computed at once (about a third of the memory of the whole cells at
-    10⁶ points); the faces and cells on first use, from the same triangulation: once it has
-    changed (an ``insert``, ``remove`` or ``move``), they are a ``ValueError`` asking for a
-    new ``voronoi()`` rather than the cells of another triangulation.
+    10⁶ points); the neighbour pairs by the same pieces when asked for, and the cells on
+    first use, from the same triangulation: once it has changed (an ``insert``, ``remove``
+    or ``move``), they are a ``ValueError`` asking for a new ``voronoi()`` rather than the
+    cells of another triangulation.
 
     >>> import numpy as np, orbitri
     >>> vor = orbitri.periodic_voronoi(np.random.default_rng(4).random((200, 2)), [1.0, 1.0])

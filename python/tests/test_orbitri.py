@@ -113,6 +113,27 @@ def test_volumes_and_neighbours_equal_freud_2d():
     _freud_compare(freud.box.Box(1.5, 1.0, is2D=True), 300, 5)
 
 
+@pytest.mark.parametrize("dim", [2, 3])
+def test_neighbours_by_pieces_equal_those_of_the_cells(dim):
+    """``neighbors()`` sums the pairs by pieces, without the cells; once ``cells()`` has built
+    them, it lists them from the cells: the same pairs and areas (a grid among random
+    points puts cells of one circumsphere side by side, measured on their whole cells)."""
+    rng = np.random.default_rng(7)
+    grid = np.stack(np.meshgrid(*[np.arange(4) / 4] * dim), -1).reshape(-1, dim)
+    pts = np.concatenate([grid, rng.random((300, dim))])
+    vor = orbitri.periodic_voronoi(pts, [1.0] * dim)
+    by_pieces = vor.neighbors()
+    assert len(vor.cells()) == len(pts)
+    from_cells = vor.neighbors()
+
+    def table(ij, shifts, areas):
+        return sorted(zip(map(tuple, ij.tolist()), map(tuple, shifts.tolist()), areas.tolist()))
+
+    a, b = table(*by_pieces), table(*from_cells)
+    assert [x[:2] for x in a] == [x[:2] for x in b] and len(a) > 2 * len(pts)
+    np.testing.assert_allclose([x[2] for x in a], [x[2] for x in b], rtol=1e-9, atol=1e-15)
+
+
 def test_attributes_like_scipy():
     rng = np.random.default_rng(6)
     pts = rng.random((500, 3))

@@ -25,8 +25,8 @@ use std::time::Duration;
 use numpy::ndarray::{Array1, Array2, Array3, ArrayD, ArrayView2, IxDyn};
 use numpy::{AllowTypeChange, IntoPyArray, PyArray1, PyArray2, PyArrayLike1, PyArrayLike2};
 use orbitri::{
-    BuildOptions, CellMeasures, FlatManifold, FlatSpace, FlatTorus, InputId, Motion, OrbitSpace,
-    Triangulation as Tri_, VoronoiCell,
+    BuildOptions, CellMeasures, FlatManifold, FlatSpace, FlatTorus, InputId, Motion, Neighbor,
+    OrbitSpace, Triangulation as Tri_, VoronoiCell,
 };
 use pyo3::exceptions::{PyIndexError, PyOverflowError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
@@ -624,6 +624,16 @@ fn vertex_neighbors<const D: usize, const N: usize, S: Served<D, N>>(
 }
 
 /// The Voronoi cells of a triangulation, stopping once `interrupt` says so.
+/// The neighbour pairs by pieces ([`Tri_::voronoi_measures_and_neighbors_until`]).
+fn pairs_of<const D: usize, const N: usize, S: Served<D, N>>(
+    t: &Tri_<D, N, S>,
+    interrupt: &(dyn Fn() -> bool + Sync),
+) -> PyResult<Vec<Neighbor<D, S::Elem>>> {
+    Ok(t.voronoi_measures_and_neighbors_until(interrupt)
+        .map_err(value_error)?
+        .1)
+}
+
 fn cells_of<const D: usize, const N: usize, S: Served<D, N>>(
     t: &Tri_<D, N, S>,
     interrupt: &(dyn Fn() -> bool + Sync),
@@ -1018,22 +1028,38 @@ enum Cells {
     Manifold3(CellsOf<3, 4, FlatManifold<3>>),
 }
 
+/// The neighbour pairs of any space (`Voronoi.neighbors()` without the cells' geometry).
+enum Pairs {
+    Two(Vec<Neighbor<2, <FlatTorus<2> as OrbitSpace<3>>::Elem>>),
+    Three(Vec<Neighbor<3, <FlatTorus<3> as OrbitSpace<4>>::Elem>>),
+    Klein(Vec<Neighbor<2, <FlatManifold<2> as OrbitSpace<3>>::Elem>>),
+    Manifold3(Vec<Neighbor<3, <FlatManifold<3> as OrbitSpace<4>>::Elem>>),
+}
+
+/// (pairs E×2, elements, areas E) of neighbour pairs.
+fn neighbor_arrays<const D: usize, const N: usize, S: Served<D, N>>(
+    py: Python<'_>,
+    pairs: &[Neighbor<D, S::Elem>],
+) -> (Py<PyAny>, Py<PyAny>, Py<PyAny>) {
+    let ij: Vec<i64> = pairs
+        .iter()
+        .flat_map(|p| [i64::from(p.i.0), i64::from(p.j.0)])
+        .collect();
+    let a: Vec<f64> = pairs.iter().map(|p| p.area).collect();
+    (
+        array2(py, pairs.len(), 2, ij).into_any().unbind(),
+        py_elements::<D, N, S>(py, &[pairs.len()], pairs.iter().map(|p| p.shift)),
+        a.into_pyarray(py).into_any().unbind(),
+    )
+}
+
 impl<const D: usize, const N: usize, S: Served<D, N>> CellsOf<D, N, S> {
     /// (pairs E×2, elements, areas E): each pair of neighbouring images once.
     fn neighbors(&self, py: Python<'_>) -> (Py<PyAny>, Py<PyAny>, Py<PyAny>) {
         let pairs = orbitri::voronoi::neighbor_pairs_by(&self.cells, |g| {
             OrbitSpace::<N>::inverse(&self.space, g)
         });
-        let ij: Vec<i64> = pairs
-            .iter()
-            .flat_map(|p| [i64::from(p.i.0), i64::from(p.j.0)])
-            .collect();
-        let a: Vec<f64> = pairs.iter().map(|p| p.area).collect();
-        (
-            array2(py, pairs.len(), 2, ij).into_any().unbind(),
-            py_elements::<D, N, S>(py, &[pairs.len()], pairs.iter().map(|p| p.shift)),
-            a.into_pyarray(py).into_any().unbind(),
-        )
+        neighbor_arrays::<D, N, S>(py, &pairs)
     }
 
     /// Every distinct point's cell as a dict.
@@ -1148,7 +1174,44 @@ impl Drop for Voronoi {
     }
 }
 
+/// An error once the triangulation has changed since `voronoi()` measured it (at `at`).
+fn unchanged(generation: &AtomicU64, at: u64) -> PyResult<()> {
+    if generation.load(Ordering::Acquire) != at {
+        return Err(PyValueError::new_err(
+            "the triangulation has changed since voronoi() measured it: call voronoi() \
+             again for the cells and neighbours of the triangulation as it is now",
+        ));
+    }
+    Ok(())
+}
+
 impl Voronoi {
+    /// The neighbour pairs by pieces, without the cells (a third of their memory); an
+    /// error once the triangulation changed.
+    fn pairs(&self, py: Python<'_>) -> PyResult<Pairs> {
+        let shared = Arc::clone(&self.tri);
+        let generation = Arc::clone(&self.generation);
+        let at = self.at;
+        let total =
+            with_tri!(&*self.tri.read_py_attached(py).map_err(poisoned)?, t => t.voronoi_polls());
+        interruptible(
+            py,
+            self.cells,
+            ("Voronoi neighbours", total),
+            move |control| {
+                let interrupt = || control.poll();
+                let guard = shared.read().map_err(poisoned)?;
+                unchanged(&generation, at)?;
+                Ok(match &*guard {
+                    Tri::Two(t) => Pairs::Two(pairs_of(t, &interrupt)?),
+                    Tri::Three(t) => Pairs::Three(pairs_of(t, &interrupt)?),
+                    Tri::Klein(t) => Pairs::Klein(pairs_of(t, &interrupt)?),
+                    Tri::Manifold3(t) => Pairs::Manifold3(pairs_of(t, &interrupt)?),
+                })
+            },
+        )
+    }
+
     /// The cells' geometry, computed on first use; an error once the triangulation changed.
     fn geometry(&self, py: Python<'_>) -> PyResult<&Cells> {
         if let Some(c) = self.geometry.get() {
@@ -1162,12 +1225,7 @@ impl Voronoi {
         let cells = interruptible(py, self.cells, ("Voronoi cells", total), move |control| {
             let interrupt = || control.poll();
             let guard = shared.read().map_err(poisoned)?;
-            if generation.load(Ordering::Acquire) != at {
-                return Err(PyValueError::new_err(
-                    "the triangulation has changed since voronoi() measured it: call voronoi() \
-                     again for the cells and neighbours of the triangulation as it is now",
-                ));
-            }
+            unchanged(&generation, at)?;
             Ok(match &*guard {
                 Tri::Two(t) => Cells::Two(cells_of(t, &interrupt)?),
                 Tri::Three(t) => Cells::Three(cells_of(t, &interrupt)?),
@@ -1211,7 +1269,15 @@ impl Voronoi {
     /// (pairs E×2, elements, areas E): each pair of neighbouring images once; a torus's
     /// elements are shifts (E×D), a manifold's (cosets E, offsets E×D).
     fn neighbors(&self, py: Python<'_>) -> PyResult<(Py<PyAny>, Py<PyAny>, Py<PyAny>)> {
-        Ok(with_cells!(self.geometry(py)?, c => c.neighbors(py)))
+        if let Some(cells) = self.geometry.get() {
+            return Ok(with_cells!(cells, c => c.neighbors(py)));
+        }
+        Ok(match self.pairs(py)? {
+            Pairs::Two(p) => neighbor_arrays::<2, 3, FlatTorus<2>>(py, &p),
+            Pairs::Three(p) => neighbor_arrays::<3, 4, FlatTorus<3>>(py, &p),
+            Pairs::Klein(p) => neighbor_arrays::<2, 3, FlatManifold<2>>(py, &p),
+            Pairs::Manifold3(p) => neighbor_arrays::<3, 4, FlatManifold<3>>(py, &p),
+        })
     }
 
     /// Every distinct point's cell as a dict: id, position, volume, centroid, vertices
