@@ -41,6 +41,13 @@ fn at(x: &L) -> [f64; 3] {
     }
 }
 
+/// True when no vertex of the lifted cell is negated: the stored cells away from the seam of
+/// the representatives (the equator), whose predicates then read the points in place.
+#[inline(always)]
+fn plain(s: &[L; 3]) -> bool {
+    !(s[0].1 .0 | s[1].1 .0 | s[2].1 .0)
+}
+
 /// The representative of `p`'s class in RP²: the one whose last non-zero coordinate (in the
 /// order z, y, x) is positive.
 pub fn canonical(p: &[f64; 3]) -> [f64; 3] {
@@ -103,6 +110,9 @@ impl OrbitSpace<3> for ProjectivePlane {
 
     #[inline]
     fn orient(&self, s: &[L; 3]) -> Sign {
+        if plain(s) {
+            return spherical::orient_unit(&s[0].0, &s[1].0, &s[2].0);
+        }
         spherical::orient_unit(&at(&s[0]), &at(&s[1]), &at(&s[2]))
     }
 
@@ -112,6 +122,12 @@ impl OrbitSpace<3> for ProjectivePlane {
     /// flat).
     #[inline]
     fn in_sphere(&self, s: &[L; 3], q: L) -> Sign {
+        if plain(s) & !q.1 .0 {
+            return match spherical::side_unit(&s[0].0, &s[1].0, &s[2].0, &q.0) {
+                Sign::Zero => tie([s[0].0, s[1].0, s[2].0], q.0),
+                decided => decided,
+            };
+        }
         let [a, b, c] = [at(&s[0]), at(&s[1]), at(&s[2])];
         let x = at(&q);
         match spherical::side_unit(&a, &b, &c, &x) {
