@@ -597,15 +597,28 @@ fn edges<const D: usize, const N: usize, S: Served<D, N>>(
     t: &Tri_<D, N, S>,
 ) -> (Py<PyAny>, Py<PyAny>, Py<PyAny>) {
     let e = t.delaunay_edges();
-    let ij: Vec<i64> = e
+    pair_arrays::<_, D, N, S>(py, &e, |x| (x.i, x.j, x.shift, x.length))
+}
+
+/// (pairs E×2, elements, values E) of pairs of images, each `row` giving `(i, j, element,
+/// value)`.
+fn pair_arrays<T, const D: usize, const N: usize, S: Served<D, N>>(
+    py: Python<'_>,
+    rows: &[T],
+    row: impl Fn(&T) -> (InputId, InputId, S::Elem, f64),
+) -> (Py<PyAny>, Py<PyAny>, Py<PyAny>) {
+    let ij: Vec<i64> = rows
         .iter()
-        .flat_map(|x| [i64::from(x.i.0), i64::from(x.j.0)])
+        .flat_map(|x| {
+            let (i, j, ..) = row(x);
+            [i64::from(i.0), i64::from(j.0)]
+        })
         .collect();
-    let l: Vec<f64> = e.iter().map(|x| x.length).collect();
+    let values: Vec<f64> = rows.iter().map(|x| row(x).3).collect();
     (
-        array2(py, e.len(), 2, ij).into_any().unbind(),
-        py_elements::<D, N, S>(py, &[e.len()], e.iter().map(|x| x.shift)),
-        l.into_pyarray(py).into_any().unbind(),
+        array2(py, rows.len(), 2, ij).into_any().unbind(),
+        py_elements::<D, N, S>(py, &[rows.len()], rows.iter().map(|x| row(x).2)),
+        values.into_pyarray(py).into_any().unbind(),
     )
 }
 
@@ -1041,16 +1054,7 @@ fn neighbor_arrays<const D: usize, const N: usize, S: Served<D, N>>(
     py: Python<'_>,
     pairs: &[Neighbor<D, S::Elem>],
 ) -> (Py<PyAny>, Py<PyAny>, Py<PyAny>) {
-    let ij: Vec<i64> = pairs
-        .iter()
-        .flat_map(|p| [i64::from(p.i.0), i64::from(p.j.0)])
-        .collect();
-    let a: Vec<f64> = pairs.iter().map(|p| p.area).collect();
-    (
-        array2(py, pairs.len(), 2, ij).into_any().unbind(),
-        py_elements::<D, N, S>(py, &[pairs.len()], pairs.iter().map(|p| p.shift)),
-        a.into_pyarray(py).into_any().unbind(),
-    )
+    pair_arrays::<_, D, N, S>(py, pairs, |p| (p.i, p.j, p.shift, p.area))
 }
 
 impl<const D: usize, const N: usize, S: Served<D, N>> CellsOf<D, N, S> {
@@ -1189,27 +1193,35 @@ impl Voronoi {
     /// The neighbour pairs by pieces, without the cells (a third of their memory); an
     /// error once the triangulation changed.
     fn pairs(&self, py: Python<'_>) -> PyResult<Pairs> {
+        self.on_measured(py, "Voronoi neighbours", |tri, interrupt| {
+            Ok(match tri {
+                Tri::Two(t) => Pairs::Two(pairs_of(t, interrupt)?),
+                Tri::Three(t) => Pairs::Three(pairs_of(t, interrupt)?),
+                Tri::Klein(t) => Pairs::Klein(pairs_of(t, interrupt)?),
+                Tri::Manifold3(t) => Pairs::Manifold3(pairs_of(t, interrupt)?),
+            })
+        })
+    }
+
+    /// `work` on the triangulation that `voronoi()` measured (interruptible, reported as
+    /// `phase`); an error once it has changed.
+    fn on_measured<T: Send + 'static>(
+        &self,
+        py: Python<'_>,
+        phase: &str,
+        work: impl FnOnce(&Tri, &(dyn Fn() -> bool + Sync)) -> PyResult<T> + Send + 'static,
+    ) -> PyResult<T> {
         let shared = Arc::clone(&self.tri);
         let generation = Arc::clone(&self.generation);
         let at = self.at;
         let total =
             with_tri!(&*self.tri.read_py_attached(py).map_err(poisoned)?, t => t.voronoi_polls());
-        interruptible(
-            py,
-            self.cells,
-            ("Voronoi neighbours", total),
-            move |control| {
-                let interrupt = || control.poll();
-                let guard = shared.read().map_err(poisoned)?;
-                unchanged(&generation, at)?;
-                Ok(match &*guard {
-                    Tri::Two(t) => Pairs::Two(pairs_of(t, &interrupt)?),
-                    Tri::Three(t) => Pairs::Three(pairs_of(t, &interrupt)?),
-                    Tri::Klein(t) => Pairs::Klein(pairs_of(t, &interrupt)?),
-                    Tri::Manifold3(t) => Pairs::Manifold3(pairs_of(t, &interrupt)?),
-                })
-            },
-        )
+        interruptible(py, self.cells, (phase, total), move |control| {
+            let interrupt = || control.poll();
+            let guard = shared.read().map_err(poisoned)?;
+            unchanged(&generation, at)?;
+            work(&guard, &interrupt)
+        })
     }
 
     /// The cells' geometry, computed on first use; an error once the triangulation changed.
@@ -1217,20 +1229,12 @@ impl Voronoi {
         if let Some(c) = self.geometry.get() {
             return Ok(c);
         }
-        let shared = Arc::clone(&self.tri);
-        let generation = Arc::clone(&self.generation);
-        let at = self.at;
-        let total =
-            with_tri!(&*self.tri.read_py_attached(py).map_err(poisoned)?, t => t.voronoi_polls());
-        let cells = interruptible(py, self.cells, ("Voronoi cells", total), move |control| {
-            let interrupt = || control.poll();
-            let guard = shared.read().map_err(poisoned)?;
-            unchanged(&generation, at)?;
-            Ok(match &*guard {
-                Tri::Two(t) => Cells::Two(cells_of(t, &interrupt)?),
-                Tri::Three(t) => Cells::Three(cells_of(t, &interrupt)?),
-                Tri::Klein(t) => Cells::Klein(cells_of(t, &interrupt)?),
-                Tri::Manifold3(t) => Cells::Manifold3(cells_of(t, &interrupt)?),
+        let cells = self.on_measured(py, "Voronoi cells", |tri, interrupt| {
+            Ok(match tri {
+                Tri::Two(t) => Cells::Two(cells_of(t, interrupt)?),
+                Tri::Three(t) => Cells::Three(cells_of(t, interrupt)?),
+                Tri::Klein(t) => Cells::Klein(cells_of(t, interrupt)?),
+                Tri::Manifold3(t) => Cells::Manifold3(cells_of(t, interrupt)?),
             })
         })?;
         // (another thread may have set it meanwhile: the same cells)
