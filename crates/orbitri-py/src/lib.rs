@@ -636,8 +636,8 @@ fn vertex_neighbors<const D: usize, const N: usize, S: Served<D, N>>(
     )
 }
 
-/// The Voronoi cells of a triangulation, stopping once `interrupt` says so.
-/// The neighbour pairs by pieces ([`Tri_::voronoi_measures_and_neighbors_until`]).
+/// The neighbour pairs by pieces ([`Tri_::voronoi_measures_and_neighbors_until`]), stopping
+/// once `interrupt` says so.
 fn pairs_of<const D: usize, const N: usize, S: Served<D, N>>(
     t: &Tri_<D, N, S>,
     interrupt: &(dyn Fn() -> bool + Sync),
@@ -647,6 +647,7 @@ fn pairs_of<const D: usize, const N: usize, S: Served<D, N>>(
         .1)
 }
 
+/// The Voronoi cells of a triangulation, stopping once `interrupt` says so.
 fn cells_of<const D: usize, const N: usize, S: Served<D, N>>(
     t: &Tri_<D, N, S>,
     interrupt: &(dyn Fn() -> bool + Sync),

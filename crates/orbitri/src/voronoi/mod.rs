@@ -382,13 +382,9 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             drop((center, stars));
         }
         let order = self.input_order(pieces.measures.len());
-        let measures = order
-            .iter()
-            .map(|&(i, p)| match p {
-                PointId::NONE => CellMeasures::from(&self.hidden_cell(i)),
-                p => pieces.measures[p.index()].take().expect("each point once"),
-            })
-            .collect();
+        let measures = self.in_order(&order, std::mem::take(&mut pieces.measures), |i| {
+            CellMeasures::from(&self.hidden_cell(i))
+        });
         let mut all = Vec::new();
         if pairs {
             all.reserve_exact(
@@ -437,8 +433,18 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
 
     /// The values of the points (`out`, indexed by point, each `Some`) and of the hidden
     /// inputs (`hidden`), in the order of first occurrence.
-    fn in_input_order<T>(&self, mut out: Vec<Option<T>>, hidden: impl Fn(InputId) -> T) -> Vec<T> {
-        self.input_order(out.len())
+    fn in_input_order<T>(&self, out: Vec<Option<T>>, hidden: impl Fn(InputId) -> T) -> Vec<T> {
+        self.in_order(&self.input_order(out.len()), out, hidden)
+    }
+
+    /// [`Self::in_input_order`] along an `order` that [`Self::input_order`] gave.
+    fn in_order<T>(
+        &self,
+        order: &[(InputId, PointId)],
+        mut out: Vec<Option<T>>,
+        hidden: impl Fn(InputId) -> T,
+    ) -> Vec<T> {
+        order
             .iter()
             .map(|&(i, p)| match p {
                 PointId::NONE => hidden(i),
