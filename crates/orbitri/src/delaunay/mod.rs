@@ -58,6 +58,19 @@ impl<O> Default for Scratch<O> {
     }
 }
 
+/// 2D working memory of an insertion, next to [`Scratch`] (kept apart: moving a larger
+/// scratch costs a copy by call).
+#[derive(Clone, Debug, Default)]
+struct Around {
+    /// Each boundary edge's ends in the order of a walk around the conflict region, and
+    /// the edge's slot in the outside cell; parallel to the scratch's `boundary`, which is
+    /// then in that order.
+    rim: Vec<(VertexId, VertexId, u8)>,
+    /// The depth-first search's stack: (index into `conflict`, next edge, step to the edge
+    /// after it, edges left).
+    stack: Vec<(u32, u8, u8, u8)>,
+}
+
 /// The result of inserting one point.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Inserted {
@@ -131,6 +144,7 @@ pub struct Engine<S: OrbitSpace<N>, const N: usize> {
     hint_shift: S::Elem,
     rng: SplitMix,
     scratch: Scratch<S::Elem>,
+    around: Around,
     /// Jump-and-walk grid of the 1-sheeted triangulation.
     locator: locator::Locator,
     /// Threads of the parallel bulk insertion (0: one by one).
@@ -163,6 +177,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             copy_hints: Vec::new(),
             rng: SplitMix::new(0x5eed),
             scratch: Scratch::default(),
+            around: Around::default(),
             locator: locator::Locator::default(),
             threads: 0,
         };

@@ -123,7 +123,7 @@ pub fn orient_unit(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> Sign {
 /// which puts each of the six products of three within `3u` (plus second order), and the
 /// evaluation adds `7u` of their sum: at most `60u·(2B)³`; `1024u·B³` decides. When it
 /// decides with anchors among the points, their infinitesimal terms are far below it.
-#[inline]
+#[inline(always)]
 pub fn side_unit(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3], q: &[f64; 3]) -> Sign {
     const ERR: f64 = 1024.0 * U * UNIT_BOUND * UNIT_BOUND * UNIT_BOUND;
     let d = |p: &[f64; 3]| [p[0] - a[0], p[1] - a[1], p[2] - a[2]];
