@@ -50,17 +50,17 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         'walk: loop {
             let r = rng.below(N);
             self.tds.prefetch_neighbours(c);
-            let mut s = self.lifted_cell(c);
+            let (mut pts, mut offs) = self.stored_cell(c);
             for k in 0..N {
                 let i = (r + k) % N;
                 let d = self.tds.cells[c.index()].n[i];
                 if d == prev {
                     continue;
                 }
-                let keep = s[i];
-                s[i] = (p, qo);
-                let o = self.space.orient(&s);
-                s[i] = keep;
+                let keep = (pts[i], offs[i]);
+                (pts[i], offs[i]) = (&p, qo);
+                let o = self.space.orient_stored(pts, &offs);
+                (pts[i], offs[i]) = keep;
                 if o == Sign::Negative {
                     if !inside(d) {
                         return None;

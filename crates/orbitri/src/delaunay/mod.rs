@@ -288,7 +288,22 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// [`Self::in_conflict`] of the stored cell `c`, `q` lifted into its frame.
     #[inline(always)]
     pub(crate) fn cell_conflicts(&self, c: CellId, q: LiftedOf<S, N>, wq: f64) -> bool {
-        self.in_conflict(&self.lifted_cell(c), &self.tds.cells[c.index()].v, q, wq)
+        if self.weighted {
+            return self.in_conflict(&self.lifted_cell(c), &self.tds.cells[c.index()].v, q, wq);
+        }
+        let (p, off) = self.stored_cell(c);
+        self.space.in_sphere_stored(p, &off, q) == Sign::Positive
+    }
+
+    /// The stored points of cell `c`'s vertices, where they are, and their offsets (the
+    /// lifted cell without copying the points).
+    #[inline(always)]
+    pub(crate) fn stored_cell(&self, c: CellId) -> ([&S::Point; N], [S::Elem; N]) {
+        let cell = &self.tds.cells[c.index()];
+        (
+            std::array::from_fn(|i| &self.points[self.point_index(cell.v[i])]),
+            cell.off,
+        )
     }
 
     /// What the switch criterion compares with the squared radii of the ladder: the

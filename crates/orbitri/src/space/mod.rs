@@ -74,6 +74,24 @@ pub trait OrbitSpace<const N: usize>: Sync + Send {
         s: &[Lifted<Self::Point, Self::Elem>; N],
         q: Lifted<Self::Point, Self::Elem>,
     ) -> Sign;
+    /// [`OrbitSpace::orient`] of the points `p` lifted by `off`, read where they are stored
+    /// (see [`OrbitSpace::in_sphere_stored`]).
+    #[inline(always)]
+    fn orient_stored(&self, p: [&Self::Point; N], off: &[Self::Elem; N]) -> Sign {
+        self.orient(&std::array::from_fn(|i| (*p[i], off[i])))
+    }
+    /// [`OrbitSpace::in_sphere`] of the points `p` lifted by `off`, read where they are
+    /// stored: a space may test them without copying them into a lifted simplex first (the
+    /// default copies).
+    #[inline(always)]
+    fn in_sphere_stored(
+        &self,
+        p: [&Self::Point; N],
+        off: &[Self::Elem; N],
+        q: Lifted<Self::Point, Self::Elem>,
+    ) -> Sign {
+        self.in_sphere(&std::array::from_fn(|i| (*p[i], off[i])), q)
+    }
     /// Exact test whether `q` lies on the circumsphere of `s` (no perturbation): the
     /// Voronoi vertices of such cells coincide.
     fn cospherical(

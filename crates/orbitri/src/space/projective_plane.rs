@@ -136,6 +136,25 @@ impl OrbitSpace<3> for ProjectivePlane {
         }
     }
 
+    #[inline(always)]
+    fn orient_stored(&self, p: [&[f64; 3]; 3], off: &[Antipode; 3]) -> Sign {
+        if !(off[0].0 | off[1].0 | off[2].0) {
+            return spherical::orient_unit(p[0], p[1], p[2]);
+        }
+        self.orient(&[(*p[0], off[0]), (*p[1], off[1]), (*p[2], off[2])])
+    }
+
+    #[inline(always)]
+    fn in_sphere_stored(&self, p: [&[f64; 3]; 3], off: &[Antipode; 3], q: L) -> Sign {
+        if !(off[0].0 | off[1].0 | off[2].0 | q.1 .0) {
+            return match spherical::side_unit(p[0], p[1], p[2], &q.0) {
+                Sign::Zero => tie([*p[0], *p[1], *p[2]], q.0),
+                decided => decided,
+            };
+        }
+        self.in_sphere(&[(*p[0], off[0]), (*p[1], off[1]), (*p[2], off[2])], q)
+    }
+
     fn cospherical(&self, s: &[L; 3], q: L) -> bool {
         spherical::side_unit(&at(&s[0]), &at(&s[1]), &at(&s[2]), &at(&q)) == Sign::Zero
     }
@@ -290,6 +309,42 @@ mod tests {
             b
         };
         sorted(f).min(sorted(f.map(|p| p.map(|x| -x))))
+    }
+
+    /// The predicates on points read where they are stored equal those on lifted copies, on
+    /// the sphere and in RP² (with and without negated vertices), ties included: four of
+    /// the cube's corners lie on one circle.
+    #[test]
+    fn predicates_on_stored_points_equal_those_on_lifted_ones() {
+        let mut r = SplitMix::new(9);
+        let mut pts: Vec<[f64; 3]> = (0..30).map(|_| r.on_sphere()).collect();
+        let c = 1.0 / 3f64.sqrt();
+        pts.extend([[c, c, c], [c, -c, c], [-c, -c, c], [-c, c, c], [c, c, -c]]);
+        let (sphere, rp2) = (Sphere::default(), ProjectivePlane::default());
+        let mut ties = 0;
+        for _ in 0..4000 {
+            let k: [usize; 4] = std::array::from_fn(|_| r.below(pts.len()));
+            if (0..4).any(|i| (0..i).any(|j| k[i] == k[j])) {
+                continue;
+            }
+            let p = [&pts[k[0]], &pts[k[1]], &pts[k[2]]];
+            let off: [Antipode; 4] = std::array::from_fn(|_| Antipode(r.below(3) == 0));
+            let lifted = [(*p[0], off[0]), (*p[1], off[1]), (*p[2], off[2])];
+            let q = (pts[k[3]], off[3]);
+            let (o, w) = ([off[0], off[1], off[2]], lifted.map(|x| (x.0, ())));
+            assert_eq!(rp2.orient_stored(p, &o), rp2.orient(&lifted));
+            assert_eq!(sphere.orient_stored(p, &[(); 3]), sphere.orient(&w));
+            if rp2.orient(&lifted) == Sign::Positive {
+                let x = rp2.in_sphere(&lifted, q);
+                assert_eq!(rp2.in_sphere_stored(p, &o, q), x);
+                ties += rp2.cospherical(&lifted, q) as usize;
+            }
+            if sphere.orient(&w) == Sign::Positive {
+                let x = sphere.in_sphere(&w, (q.0, ()));
+                assert_eq!(sphere.in_sphere_stored(p, &[(); 3], (q.0, ())), x);
+            }
+        }
+        assert!(ties > 0, "some picks are four corners on one circle");
     }
 
     #[test]

@@ -187,6 +187,19 @@ impl OrbitSpace<3> for Sphere {
         }
     }
 
+    #[inline(always)]
+    fn orient_stored(&self, p: [&[f64; 3]; 3], _: &[(); 3]) -> Sign {
+        spherical::orient_unit(p[0], p[1], p[2])
+    }
+
+    #[inline(always)]
+    fn in_sphere_stored(&self, p: [&[f64; 3]; 3], _: &[(); 3], q: L) -> Sign {
+        match spherical::side_unit(p[0], p[1], p[2], &q.0) {
+            Sign::Zero => tie(&[(*p[0], ()), (*p[1], ()), (*p[2], ())], q),
+            decided => decided,
+        }
+    }
+
     fn cospherical(&self, s: &[L; 3], q: L) -> bool {
         spherical::side_unit(&s[0].0, &s[1].0, &s[2].0, &q.0) == Sign::Zero
     }
