@@ -36,6 +36,15 @@ pub type FlatTorus2 = FlatTorus<2>;
 /// The 3D flat torus.
 pub type FlatTorus3 = FlatTorus<3>;
 
+/// The lifted simplex of the points `p` lifted by `off` (a copy, for the rare exact paths
+/// of the predicates on stored points).
+pub(super) fn lift<const D: usize, const N: usize>(
+    p: [&[f64; D]; N],
+    off: &[[i8; D]; N],
+) -> [L<D>; N] {
+    std::array::from_fn(|i| (*p[i], off[i]))
+}
+
 #[inline]
 fn widen<const D: usize>(o: [i8; D]) -> [i32; D] {
     o.map(|x| x as i32)
@@ -258,16 +267,27 @@ impl<const D: usize> FlatTorus<D> {
         s: [&L<D>; K],
         base: &L<D>,
     ) -> ([[f64; D]; K], [f64; K]) {
+        self.rows_stored(s.map(|x| &x.0), s.map(|x| x.1), (&base.0, base.1))
+    }
+
+    /// [`Self::rows`] of the points `p` lifted by `off`, read where they are stored.
+    #[inline(always)]
+    pub(super) fn rows_stored<const K: usize>(
+        &self,
+        p: [&[f64; D]; K],
+        off: [[i8; D]; K],
+        base: (&[f64; D], [i8; D]),
+    ) -> ([[f64; D]; K], [f64; K]) {
         let mut d = [[0.0; D]; K];
         let mut b = [0.0; K];
-        if s.iter().all(|x| x.1 == base.1) {
+        if off.iter().all(|&o| o == base.1) {
             for i in 0..K {
-                (d[i], b[i]) = plain_diff(&s[i].0, &base.0);
+                (d[i], b[i]) = plain_diff(p[i], base.0);
             }
         } else {
             let t0 = widen(base.1);
             for i in 0..K {
-                (d[i], b[i]) = lifted_diff(&self.lattice.rows, &s[i].0, widen(s[i].1), &base.0, t0);
+                (d[i], b[i]) = lifted_diff(&self.lattice.rows, p[i], widen(off[i]), base.0, t0);
             }
         }
         (d, b)
@@ -764,6 +784,48 @@ mod tests {
             assert!((d2 - (rho + ws[0])).abs() < 1e-6 * d2.max(1.0));
         }
         assert!(decided > 1000);
+    }
+
+    /// The predicates on stored points equal those on lifted copies, with offsets shared
+    /// or not, on random points and on points of a quarter grid (cospherical ties).
+    fn stored_checks<const D: usize, const N: usize>(t: &FlatTorus<D>) -> usize
+    where
+        FlatTorus<D>: OrbitSpace<N, Point = [f64; D], Elem = [i8; D]>,
+    {
+        let mut seed = 3u64;
+        let mut ties = 0;
+        for k in 0..4000 {
+            let lifted = |seed: &mut u64| -> L<D> {
+                let x = |seed: &mut u64| match k % 2 {
+                    0 => random(seed),
+                    _ => (random(seed) * 4.0).floor() / 4.0,
+                };
+                let o = match k % 3 {
+                    0 => [1; D],
+                    _ => std::array::from_fn(|_| (random(seed) * 3.0) as i8 - 1),
+                };
+                (std::array::from_fn(|_| x(seed)), o)
+            };
+            let s: [L<D>; N] = std::array::from_fn(|_| lifted(&mut seed));
+            let q = lifted(&mut seed);
+            let (p, off) = (s.each_ref().map(|x| &x.0), s.map(|x| x.1));
+            assert_eq!(t.orient_stored(p, &off), t.orient(&s));
+            let distinct = s.iter().all(|&x| !t.coincide(x, q));
+            if t.orient(&s) == Sign::Positive && distinct {
+                assert_eq!(t.in_sphere_stored(p, &off, q), t.in_sphere(&s, q));
+                ties += t.cospherical(&s, q) as usize;
+            }
+        }
+        ties
+    }
+
+    #[test]
+    fn predicates_on_stored_points_equal_those_on_lifted_ones() {
+        let tri3 = FlatTorus3::triclinic([[1.0, 0.0, 0.0], [0.3, 0.9, 0.0], [0.2, -0.1, 1.1]]);
+        stored_checks::<3, 4>(&tri3.unwrap());
+        stored_checks::<2, 3>(&FlatTorus2::triclinic([[1.0, 0.0], [0.4, 0.8]]).unwrap());
+        assert!(stored_checks::<3, 4>(&FlatTorus3::cuboid([1.0; 3]).unwrap()) > 0);
+        assert!(stored_checks::<2, 3>(&FlatTorus2::cuboid([1.0; 2]).unwrap()) > 0);
     }
 
     #[test]

@@ -5,7 +5,7 @@
 use num_bigint::BigInt;
 
 use super::flat_torus::{
-    flat_torus_plugin, UnperturbedInSphere, CENTER_TOLERANCE, L, RADIUS_TOLERANCE,
+    flat_torus_plugin, lift, UnperturbedInSphere, CENTER_TOLERANCE, L, RADIUS_TOLERANCE,
 };
 use super::{FlatTorus, OrbitSpace};
 use crate::predicates::exact;
@@ -98,6 +98,21 @@ impl OrbitSpace<3> for FlatTorus<2> {
         match self.in_sphere_raw(s, q) {
             Sign::Zero => self.perturbed(s, q, |t| self.orient(t)),
             sign => sign,
+        }
+    }
+
+    #[inline(always)]
+    fn orient_stored(&self, p: [&[f64; 2]; 3], off: &[[i8; 2]; 3]) -> Sign {
+        let (d, b) = self.rows_stored([p[1], p[2]], [off[1], off[2]], (p[0], off[0]));
+        filter::orient2(&d, b).unwrap_or_else(|| self.orient_exact(&lift(p, off)))
+    }
+
+    #[inline(always)]
+    fn in_sphere_stored(&self, p: [&[f64; 2]; 3], off: &[[i8; 2]; 3], q: L2) -> Sign {
+        let (d, b) = self.rows_stored(p, *off, (&q.0, q.1));
+        match filter::in_circle(&d, b) {
+            Some(Sign::Zero) | None => self.in_sphere(&lift(p, off), q),
+            Some(sign) => sign,
         }
     }
 

@@ -4,7 +4,7 @@
 use num_bigint::BigInt;
 
 use super::flat_torus::{
-    flat_torus_plugin, UnperturbedInSphere, CENTER_TOLERANCE, L, RADIUS_TOLERANCE,
+    flat_torus_plugin, lift, UnperturbedInSphere, CENTER_TOLERANCE, L, RADIUS_TOLERANCE,
 };
 use super::{FlatTorus, OrbitSpace};
 use crate::predicates::exact;
@@ -128,6 +128,21 @@ impl OrbitSpace<4> for FlatTorus<3> {
         match self.in_sphere_raw(s, q) {
             Sign::Zero => self.perturbed(s, q, |t| self.orient(t)),
             sign => sign,
+        }
+    }
+
+    #[inline(always)]
+    fn orient_stored(&self, p: [&[f64; 3]; 4], off: &[[i8; 3]; 4]) -> Sign {
+        let (d, b) = self.rows_stored([p[1], p[2], p[3]], [off[1], off[2], off[3]], (p[0], off[0]));
+        filter::orient3(&d, b).unwrap_or_else(|| self.orient_exact(&lift(p, off)))
+    }
+
+    #[inline(always)]
+    fn in_sphere_stored(&self, p: [&[f64; 3]; 4], off: &[[i8; 3]; 4], q: L3) -> Sign {
+        let (d, b) = self.rows_stored(p, *off, (&q.0, q.1));
+        match filter::in_sphere3(&d, b) {
+            Some(Sign::Zero) | None => self.in_sphere(&lift(p, off), q),
+            Some(sign) => sign,
         }
     }
 
