@@ -2,7 +2,8 @@
 # The parallel construction (issue "Performance", item 2): `orbitri triangulate` one point
 # at a time (the default) against `--threads 1` and `--threads 2` (the parallel build), side
 # by side in one run, alternating per repetition, on N uniform points in the unit cube
-# (`orbitri generate`, case torus) and on the unit sphere (case sphere). Raw lines go to
+# (`orbitri generate`, case torus), in the unit square (case square) and on the unit sphere
+# (case sphere). Raw lines go to
 # bench/out/parallel_raw.txt; medians are printed per case and command.
 #
 # usage: bench/parallel.sh [REPS] [N ...]      default: 5 reps, N = 1000000
@@ -16,8 +17,10 @@ commit=$(git -C "$root" rev-parse --short HEAD)
 stamp="commit=$commit date=$(date -u +%F)"
 for n in $ns; do
     cube=$out/cube_$n.txt
+    square=$out/square_$n.txt
     sphere=$out/unit_sphere_$n.txt
     [ -f "$cube" ] || "$orb" generate "$n" --seed 1 -o "$cube"
+    [ -f "$square" ] || "$orb" generate "$n" --seed 1 --dim 2 -o "$square"
     [ -f "$sphere" ] || python3 - "$n" "$sphere" <<'PY'
 import math, random, sys
 n, path = int(sys.argv[1]), sys.argv[2]
@@ -34,6 +37,8 @@ PY
             [ "$threads" = none ] || flag=(--threads "$threads")
             line=$("$orb" triangulate "$cube" --box 1 1 1 "${flag[@]}" --stats --format cells -o /dev/null 2>&1)
             echo "tool=orbitri case=torus cmd=threads-$threads N=$n rep=$rep $line $stamp"
+            line=$("$orb" triangulate "$square" --box 1 1 "${flag[@]}" --stats --format cells -o /dev/null 2>&1)
+            echo "tool=orbitri case=square cmd=threads-$threads N=$n rep=$rep $line $stamp"
             line=$("$orb" triangulate "$sphere" --space sphere --normalize "${flag[@]}" --stats --format cells -o /dev/null 2>&1)
             echo "tool=orbitri case=sphere cmd=threads-$threads N=$n rep=$rep $line $stamp"
         done

@@ -6,6 +6,7 @@ use crate::ids::{CellId, PointId, VertexId};
 use crate::predicates::Sign;
 use crate::sort::SplitMix;
 use crate::space::OrbitSpace;
+use crate::tds::Cell;
 
 /// Why a lifted point was not inserted.
 pub(crate) enum Refused {
@@ -20,8 +21,62 @@ pub(crate) enum Refused {
 /// 2D: true when the boundary edges of `rim` (all `edges` of them) chain into one closed
 /// walk, each edge's end the next one's start (always, for a disk; checked, since the fan
 /// relies on it).
-fn closes(rim: &[(VertexId, VertexId, u8)], edges: usize) -> bool {
-    rim.len() == edges && (0..rim.len()).all(|k| rim[k].1 == rim[(k + 1) % rim.len()].0)
+pub(super) fn closes(rim: &[(VertexId, VertexId, u8)], edges: usize) -> bool {
+    rim.len() == edges
+        && rim.windows(2).all(|w| w[0].1 == w[1].0)
+        && rim.last().map(|e| e.1) == rim.first().map(|e| e.0)
+}
+
+/// A frame of the 2D search around a conflict region: the triangle's index in the region,
+/// its next edge, the turn from edge to edge (1 or 2) and the edges left.
+pub(super) type Frame = (u32, u8, u8, u8);
+
+/// The next edge of the 2D search around a region: (the triangle's index in the region,
+/// the edge, the turn), its frame moved past it; `None` when the search is over.
+#[inline(always)]
+pub(super) fn next_edge(stack: &mut Vec<Frame>) -> Option<(u32, usize, usize)> {
+    while let Some(top) = stack.last_mut() {
+        if top.3 == 0 {
+            stack.pop();
+            continue;
+        }
+        let (ci, i, step) = (top.0, top.1 as usize, top.2 as usize);
+        top.1 = ((i + step) % 3) as u8;
+        top.3 -= 1;
+        return Some((ci, i, step));
+    }
+    None
+}
+
+/// The ends of edge `i` of a triangle with vertices `v`, in the order of a walk around it
+/// turning by `step`.
+#[inline(always)]
+pub(super) fn edge_ends(v: &[VertexId], i: usize, step: usize) -> (VertexId, VertexId) {
+    (v[(i + step) % 3], v[(i + 2 * step) % 3])
+}
+
+/// Enters triangle `k` of the region (vertices `v`) through its edge `j`, whose walk ends at
+/// `b`: the search goes on from the edge after it, `b` to the third vertex.
+#[inline(always)]
+pub(super) fn enter(stack: &mut Vec<Frame>, k: usize, v: &[VertexId], j: usize, b: VertexId) {
+    let step = if v[(j + 1) % 3] == b { 1 } else { 2 };
+    stack.push((k as u32, ((j + step) % 3) as u8, step as u8, 2));
+}
+
+/// The slot of vertex `y` in a new 2D cell with vertices `v`, built on edge `i` of a
+/// conflict cell (`y` at slot `i + 1` or `i + 2`, unless canonicalizing moved it).
+#[inline(always)]
+pub(super) fn slot_in<const N: usize>(v: &[VertexId; N], y: VertexId, i: usize) -> usize {
+    let (s1, s2) = ((i + 1) % 3, (i + 2) % 3);
+    if v[s1] == y {
+        s1
+    } else if v[s2] == y {
+        s2
+    } else {
+        v.iter()
+            .position(|&w| w == y)
+            .expect("the cell holds the vertex")
+    }
 }
 
 impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
@@ -158,8 +213,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                     continue;
                 }
                 if st != outside {
-                    let qd = self.space.relative(qo, self.translation(c, i, d));
-                    if self.cell_conflicts(d, (p, qd), wq) {
+                    if let Some(qd) = self.conflict_across((c, i, d), (p, qo), wq) {
                         self.tds.set_stamp(d, inside);
                         self.tds.prefetch_neighbours(d);
                         scratch.conflict.push((d, qd));
@@ -190,14 +244,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         scratch.conflict.push((c0, q0));
         self.tds.set_stamp(c0, inside);
         around.stack.push((0, 0, 1, 3));
-        while let Some(top) = around.stack.last_mut() {
-            if top.3 == 0 {
-                around.stack.pop();
-                continue;
-            }
-            let (ci, i, step) = (top.0, top.1 as usize, top.2 as usize);
-            top.1 = ((i + step) % 3) as u8;
-            top.3 -= 1;
+        while let Some((ci, i, step)) = next_edge(&mut around.stack) {
             let (c, qo) = scratch.conflict[ci as usize];
             let cell = &self.tds.cells[c.index()];
             let d = cell.n[i];
@@ -206,26 +253,15 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 continue;
             }
             // the edge's ends in the order of the walk
-            let (a, b) = (cell.v[(i + step) % 3], cell.v[(i + 2 * step) % 3]);
-            let j = self.tds.cells[d.index()]
-                .mirror(c)
-                .expect("symmetric neighbours");
+            let (a, b) = edge_ends(&cell.v, i, step);
+            let j = self.mirror_of(d, c);
             if st != outside {
-                let qd = self.space.relative(qo, self.translation(c, i, d));
-                if self.cell_conflicts(d, (p, qd), wq) {
+                if let Some(qd) = self.conflict_across((c, i, d), (p, qo), wq) {
                     self.tds.set_stamp(d, inside);
                     self.tds.prefetch_neighbours(d);
                     scratch.conflict.push((d, qd));
-                    // on from the edge after the shared one: `a` to the third vertex
-                    let step = if self.tds.cells[d.index()].v[(j + 1) % 3] == b {
-                        1
-                    } else {
-                        2
-                    };
-                    let k = (scratch.conflict.len() - 1) as u32;
-                    around
-                        .stack
-                        .push((k, ((j + step) % 3) as u8, step as u8, 2));
+                    let k = scratch.conflict.len() - 1;
+                    enter(&mut around.stack, k, &self.tds.cells[d.index()].v, j, b);
                     continue;
                 }
                 self.tds.set_stamp(d, outside);
@@ -257,15 +293,9 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// the next (they share the edge from `x` to the end of this one's edge).
     fn star_around(&mut self, scratch: &mut Scratch<S::Elem>, x: VertexId) {
         let rim = std::mem::take(&mut self.around.rim);
-        for (&(ci, i), &(_, _, j)) in scratch.boundary.iter().zip(&rim) {
-            let (c, qo) = scratch.conflict[ci as usize];
-            let i = i as usize;
-            let cell = self.tds.cells[c.index()];
-            let mut v = cell.v;
-            let mut off = cell.off;
-            v[i] = x;
-            off[i] = qo;
-            let nc = self.make_cell(v, off);
+        for (&facet, &(_, _, j)) in scratch.boundary.iter().zip(&rim) {
+            let (nc, cell) = self.cell_on_facet(scratch, facet, x);
+            let i = facet.1 as usize;
             self.link(nc, self.slot(nc, x, i), cell.n[i], j as usize);
             scratch.created.push(nc);
         }
@@ -282,21 +312,48 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.around.rim = rim;
     }
 
-    /// The slot of vertex `y` in the new 2D cell `c` built on edge `i` of a conflict cell
-    /// (`y` at slot `i + 1` or `i + 2`, unless canonicalizing moved it).
+    /// The point `q` (lifted by `q.1` in cell `c`) lifted into `c`'s neighbour `d` across
+    /// facet `i`, if `d` is in conflict with it (weight `wq`).
+    #[inline(always)]
+    pub(super) fn conflict_across(
+        &self,
+        (c, i, d): (CellId, usize, CellId),
+        (p, qo): LiftedOf<S, N>,
+        wq: f64,
+    ) -> Option<S::Elem> {
+        let qd = self.space.relative(qo, self.translation(c, i, d));
+        self.cell_conflicts(d, (p, qd), wq).then_some(qd)
+    }
+
+    /// The slot of neighbour `c` in its neighbour `d`.
+    #[inline(always)]
+    pub(super) fn mirror_of(&self, d: CellId, c: CellId) -> usize {
+        self.tds.cells[d.index()]
+            .mirror(c)
+            .expect("symmetric neighbours")
+    }
+
+    /// The new cell on boundary facet `(ci, i)` of the conflict region: conflict cell `ci`
+    /// with `x` (lifted as the point is there) in place of its vertex `i`; returned with
+    /// the conflict cell as it is.
+    #[inline(always)]
+    fn cell_on_facet(
+        &mut self,
+        scratch: &Scratch<S::Elem>,
+        (ci, i): (u32, u8),
+        x: VertexId,
+    ) -> (CellId, Cell<S::Elem, N>) {
+        let (c, qo) = scratch.conflict[ci as usize];
+        let cell = self.tds.cells[c.index()];
+        let (mut v, mut off) = (cell.v, cell.off);
+        (v[i as usize], off[i as usize]) = (x, qo);
+        (self.make_cell(v, off), cell)
+    }
+
+    /// The slot of vertex `y` in the new 2D cell `c` built on edge `i` of a conflict cell.
     #[inline(always)]
     fn slot_of(&self, c: CellId, y: VertexId, i: usize) -> usize {
-        let v = &self.tds.cells[c.index()].v;
-        let (s1, s2) = ((i + 1) % 3, (i + 2) % 3);
-        if v[s1] == y {
-            s1
-        } else if v[s2] == y {
-            s2
-        } else {
-            v.iter()
-                .position(|&w| w == y)
-                .expect("the cell holds the vertex")
-        }
+        slot_in(&self.tds.cells[c.index()].v, y, i)
     }
 
     /// The new cells, each linked around its ridges by rotating through the conflict
@@ -305,19 +362,11 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         let inside = self.tds.stamp(scratch.conflict[0].0);
         // 1. one new cell per boundary facet, linked to the outside neighbour; the conflict
         //    cell's pointer through that facet is redirected to the new cell.
-        for &(ci, i) in &scratch.boundary {
-            let (c, qo) = scratch.conflict[ci as usize];
-            let i = i as usize;
-            let cell = self.tds.cells[c.index()];
-            let mut v = cell.v;
-            let mut off = cell.off;
-            v[i] = x;
-            off[i] = qo;
-            let nc = self.make_cell(v, off);
+        for &facet in &scratch.boundary {
+            let (nc, cell) = self.cell_on_facet(scratch, facet, x);
+            let (c, i) = (scratch.conflict[facet.0 as usize].0, facet.1 as usize);
             let d = cell.n[i];
-            let j = self.tds.cells[d.index()]
-                .mirror(c)
-                .expect("symmetric neighbours");
+            let j = self.mirror_of(d, c);
             self.link(nc, self.slot(nc, x, i), d, j);
             self.tds.cells[c.index()].n[i] = nc;
             scratch.created.push(nc);

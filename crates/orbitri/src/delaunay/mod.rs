@@ -68,7 +68,7 @@ struct Around {
     rim: Vec<(VertexId, VertexId, u8)>,
     /// The depth-first search's stack: (index into `conflict`, next edge, step to the edge
     /// after it, edges left).
-    stack: Vec<(u32, u8, u8, u8)>,
+    stack: Vec<insert::Frame>,
 }
 
 /// The result of inserting one point.

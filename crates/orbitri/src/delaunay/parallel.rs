@@ -32,7 +32,7 @@ use std::sync::atomic::{AtomicU32, AtomicUsize};
 
 use rayon::prelude::*;
 
-use super::insert::Refused;
+use super::insert::{closes, edge_ends, enter, next_edge, slot_in, Frame, Refused};
 use super::{Engine, HiddenPoint, Inserted};
 use crate::ids::{CellId, PointId, VertexId};
 use crate::sort::SplitMix;
@@ -197,6 +197,12 @@ struct Chunk<O, const N: usize> {
     /// Per region cell and facet: the index of the region cell across, or `OUTSIDE`.
     links: Vec<[u32; N]>,
     marks: Marks,
+    /// 2D: the visits made (marks from the chunk's stamps), the boundary edges' ends in
+    /// the order of a walk around the region with the facet across, and the search's stack
+    /// (see [`Engine::probe_around`]).
+    visits: u32,
+    rim: Vec<(VertexId, VertexId, u8)>,
+    stack: Vec<Frame>,
     /// Free slots for the chunk's new cells: freed ones first (its regions' leftovers),
     /// then `fresh`.
     spare: Vec<CellId>,
@@ -226,6 +232,9 @@ impl<O, const N: usize> Chunk<O, N> {
             across: Vec::new(),
             links: Vec::new(),
             marks: Marks::new(),
+            visits: 0,
+            rim: Vec::new(),
+            stack: Vec::new(),
             spare,
             fresh,
             outcomes: Vec::new(),
@@ -265,15 +274,46 @@ impl Shared {
     }
 }
 
-/// Which chunk of the current pass owns a cell, kept in the cell's stamp as `first +
-/// chunk` (read with the cell: no other memory to wait for): the one that made it in this
-/// pass, else the one whose key range holds the key of its vertex 0 (stamped before the
-/// pass).
+/// Which chunk of the current pass owns a cell, kept in the cell's stamp (read with the
+/// cell: no other memory to wait for): the one that made it in this pass, else the one
+/// whose key range holds the key of its vertex 0 (stamped before the pass). Chunk `j` owns
+/// the stamps `first + (j << shift)` and the `2^shift − 1` after it: the first marks its
+/// cells, the others its visits (in 2D, an inside and an outside mark per point), so that
+/// a visited cell stays its own.
 #[derive(Clone, Copy, Debug)]
 struct Ownership {
-    /// The stamp of chunk 0 (values that no visit takes, from
+    /// The stamp of chunk 0 (values that no other visit takes, from
     /// [`crate::tds::Tds::reserve_stamps`]).
     first: u32,
+    shift: u32,
+}
+
+impl Ownership {
+    /// The shift that leaves room for a visit per point in chunks of `len` points, `count`
+    /// of them (capped: a chunk out of marks defers its other points).
+    fn shift_for(count: usize, len: usize) -> u32 {
+        let shift = (2 * len + 1).next_power_of_two().trailing_zeros();
+        shift.min(30 - count.next_power_of_two().trailing_zeros())
+    }
+
+    /// The chunk owning a cell of stamp `s` (`count` or more for none).
+    #[inline(always)]
+    fn owner(self, s: u32) -> u32 {
+        s.wrapping_sub(self.first) >> self.shift
+    }
+
+    /// The stamp of chunk `j`'s cells.
+    #[inline(always)]
+    fn stamp(self, j: u32) -> u32 {
+        self.first + (j << self.shift)
+    }
+
+    /// The inside and outside marks of chunk `j`'s visit `k`, if it has that many.
+    #[inline(always)]
+    fn visit(self, j: u32, k: u32) -> Option<(u32, u32)> {
+        let s = self.stamp(j) + 2 * k;
+        (2 * k + 2 < 1 << self.shift).then_some((s + 1, s + 2))
+    }
 }
 
 /// The cell store, written by several chunks at once, each only in the cells it owns and
@@ -331,7 +371,7 @@ impl<S: OrbitSpace<N>, const N: usize> Pass<'_, S, N> {
     /// # Safety
     /// The chunk is this thread's alone.
     unsafe fn run(&self, ch: &mut Chunk<S::Elem, N>) {
-        let stamp = self.own.first + ch.id;
+        let stamp = self.own.stamp(ch.id);
         for s in ch.range.clone() {
             if ch.full {
                 break;
@@ -345,7 +385,8 @@ impl<S: OrbitSpace<N>, const N: usize> Pass<'_, S, N> {
                     }
                 }
             }
-            self.engine.probe(self.wave[s], ch, &self.own);
+            self.engine
+                .probe(self.wave[s], ch, &self.own, &self.cells, self.vcell);
             let outcome = match ch.found {
                 Found::Region => {
                     let x = VertexId::new(self.base + s);
@@ -578,8 +619,10 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         let dead = Cell::new([VertexId::NONE; N], [self.space.identity(); N]);
         self.tds.cells.resize(slots, dead);
         // every live cell stamped with its owner: the chunk whose keys hold its vertex 0's
+        let shift = Ownership::shift_for(count, n.div_ceil(count));
         let own = Ownership {
-            first: self.tds.reserve_stamps(count as u32),
+            first: self.tds.reserve_stamps((count as u32) << shift),
+            shift,
         };
         let bounds: Vec<u64> = (1..count).map(|j| wave[j * n / count].3).collect();
         let keys = &shared.keys;
@@ -590,7 +633,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             .for_each(|c| {
                 if c.v[0] != VertexId::NONE {
                     let key = keys[c.v[0].index()];
-                    c.set_stamp(own.first + bounds.partition_point(|&b| b <= key) as u32);
+                    c.set_stamp(own.stamp(bounds.partition_point(|&b| b <= key) as u32));
                 }
             });
         chunks
@@ -662,13 +705,20 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// The chunk that owns live cell `c` in the current pass.
     #[inline(always)]
     fn owner_of(&self, own: &Ownership, c: CellId) -> u32 {
-        self.tds.cells[c.index()].stamp().wrapping_sub(own.first)
+        own.owner(self.tds.cells[c.index()].stamp())
     }
 
     /// The probe of a chunk's next point: locates it (walking from the chunk's last
     /// insertion) and collects its conflict region, reading only cells the chunk owns and
     /// their neighbours.
-    fn probe(&self, (_, p, _, key): Item<S::Point>, ch: &mut Chunk<S::Elem, N>, own: &Ownership) {
+    fn probe(
+        &self,
+        (_, p, _, key): Item<S::Point>,
+        ch: &mut Chunk<S::Elem, N>,
+        own: &Ownership,
+        cells: &SharedCells<S::Elem, N>,
+        vcell: &[AtomicU32],
+    ) {
         let me = ch.id;
         let owned = |c: CellId| self.owner_of(own, c) == me;
         ch.found = Found::Foreign;
@@ -688,6 +738,95 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             ch.found = Found::Hidden;
             return;
         }
+        let found = if N == 3 {
+            // SAFETY: the pass's cells; the chunk writes only the stamps of cells it owns.
+            unsafe { self.probe_around(p, (c0, q0), ch, own, (cells, vcell)) }
+        } else {
+            self.probe_breadth(p, (c0, q0), ch, own)
+        };
+        if found {
+            ch.found = if self.hides() && self.hides_vertices(&ch.conflict, &ch.boundary) {
+                Found::Alone
+            } else {
+                Found::Region
+            };
+        }
+    }
+
+    /// 2D: the conflict region of `p` from cell `c0` (holding it lifted by `q0`) by
+    /// depth-first search, as [`Engine::conflict_region`] finds it, its boundary edges in
+    /// the order of a walk around it (`rim`), the visit's marks stamps of the chunk (a
+    /// visited cell stays its own). False when the search meets a cell the chunk does not
+    /// own, or the chunk has no marks left.
+    ///
+    /// # Safety
+    /// `cells` is the pass's store, in which no other chunk writes the cells this one owns.
+    unsafe fn probe_around(
+        &self,
+        p: S::Point,
+        (c0, q0): (CellId, S::Elem),
+        ch: &mut Chunk<S::Elem, N>,
+        own: &Ownership,
+        (cells, vcell): (&SharedCells<S::Elem, N>, &[AtomicU32]),
+    ) -> bool {
+        let Some((inside, outside)) = own.visit(ch.id, ch.visits) else {
+            ch.full = true;
+            return false;
+        };
+        ch.visits += 1;
+        ch.conflict.clear();
+        ch.boundary.clear();
+        ch.across.clear();
+        ch.rim.clear();
+        ch.stack.clear();
+        ch.conflict.push((c0, q0));
+        (*cells.get(c0)).set_stamp(inside);
+        ch.orphans.clear();
+        orphans_of(vcell, c0, &self.tds.cells[c0.index()].v, &mut ch.orphans);
+        ch.stack.push((0, 0, 1, 3));
+        while let Some((ci, i, step)) = next_edge(&mut ch.stack) {
+            let (c, qo) = ch.conflict[ci as usize];
+            let cell = &self.tds.cells[c.index()];
+            let d = cell.n[i];
+            let st = self.tds.cells[d.index()].stamp();
+            if st == inside {
+                continue;
+            }
+            if own.owner(st) != ch.id {
+                return false;
+            }
+            let (a, b) = edge_ends(&cell.v, i, step);
+            let j = self.mirror_of(d, c);
+            if st != outside {
+                if let Some(qd) = self.conflict_across((c, i, d), (p, qo), 0.0) {
+                    (*cells.get(d)).set_stamp(inside);
+                    self.tds.prefetch_neighbours(d);
+                    orphans_of(vcell, d, &self.tds.cells[d.index()].v, &mut ch.orphans);
+                    ch.conflict.push((d, qd));
+                    let k = ch.conflict.len() - 1;
+                    enter(&mut ch.stack, k, &self.tds.cells[d.index()].v, j, b);
+                    continue;
+                }
+                (*cells.get(d)).set_stamp(outside);
+            }
+            ch.boundary.push((ci, i as u8));
+            ch.across.push((d, j as u8));
+            ch.rim.push((a, b, j as u8));
+        }
+        closes(&ch.rim, ch.boundary.len())
+    }
+
+    /// The conflict region of `p` from cell `c0` (holding it lifted by `q0`) by
+    /// breadth-first search, with the links between its cells; false when the search meets
+    /// a cell the chunk does not own.
+    fn probe_breadth(
+        &self,
+        p: S::Point,
+        (c0, q0): (CellId, S::Elem),
+        ch: &mut Chunk<S::Elem, N>,
+        own: &Ownership,
+    ) -> bool {
+        let owned = |c: CellId| self.owner_of(own, c) == ch.id;
         ch.marks.clear();
         ch.conflict.clear();
         ch.links.clear();
@@ -709,10 +848,9 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                     }
                     None => {
                         if !owned(d) {
-                            return;
+                            return false;
                         }
-                        let qd = self.space.relative(qo, self.translation(c, i, d));
-                        if self.cell_conflicts(d, (p, qd), 0.0) {
+                        if let Some(qd) = self.conflict_across((c, i, d), (p, qo), 0.0) {
                             let k = ch.conflict.len() as u32;
                             ch.marks.insert(d, k);
                             ch.conflict.push((d, qd));
@@ -723,19 +861,13 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                         ch.marks.insert(d, OUTSIDE);
                     }
                 }
-                let j = self.tds.cells[d.index()]
-                    .mirror(c)
-                    .expect("symmetric neighbours");
+                let j = self.mirror_of(d, c);
                 ch.boundary.push((next as u32, i as u8));
                 ch.across.push((d, j as u8));
             }
             next += 1;
         }
-        ch.found = if self.hides() && self.hides_vertices(&ch.conflict, &ch.boundary) {
-            Found::Alone
-        } else {
-            Found::Region
-        };
+        true
     }
 }
 
@@ -763,24 +895,23 @@ unsafe fn commit<S: OrbitSpace<N>, const N: usize>(
     if ch.spare.len() + ch.fresh.len() < extra {
         return false;
     }
-    let (mut old, mut new, mut ids, mut on_facet, mut orphans) = (
-        std::mem::take(&mut ch.old),
-        std::mem::take(&mut ch.new),
-        std::mem::take(&mut ch.ids),
-        std::mem::take(&mut ch.on_facet),
-        std::mem::take(&mut ch.orphans),
+    let (old, new, ids, on_facet, orphans) = (
+        &mut ch.old,
+        &mut ch.new,
+        &mut ch.ids,
+        &mut ch.on_facet,
+        &mut ch.orphans,
     );
     old.clear();
     old.extend(ch.conflict.iter().map(|&(c, _)| *cells.get(c)));
     // (a vertex whose cell is in the region is the chunk's to point elsewhere: no other
     // chunk writes it meanwhile, since it points at none of their regions)
-    orphans.clear();
-    for (cell, &(c, _)) in old.iter().zip(&ch.conflict) {
-        orphans.extend(
-            cell.v
-                .iter()
-                .filter(|&&v| vcell[v.index()].load(Relaxed) == c.0),
-        );
+    if N != 3 {
+        // (2D: found by the probe)
+        orphans.clear();
+        for (cell, &(c, _)) in old.iter().zip(&ch.conflict) {
+            orphans_of(vcell, c, &cell.v, orphans);
+        }
     }
     ids.clear();
     ids.extend(ch.conflict.iter().map(|&(c, _)| c).take(ch.boundary.len()));
@@ -791,12 +922,9 @@ unsafe fn commit<S: OrbitSpace<N>, const N: usize>(
         });
         ids.push(id);
     }
-    on_facet.clear();
-    on_facet.resize(old.len(), [u32::MAX; N]);
     new.clear();
     for (k, &(ci, i)) in ch.boundary.iter().enumerate() {
         let (ci, i) = (ci as usize, i as usize);
-        on_facet[ci][i] = k as u32;
         let mut cell = old[ci];
         cell.v[i] = x;
         cell.off[i] = ch.conflict[ci].1;
@@ -808,34 +936,26 @@ unsafe fn commit<S: OrbitSpace<N>, const N: usize>(
         cell.n[slot] = ch.across[k].0;
         new.push(cell);
     }
-    for k in 0..new.len() {
-        let (ci, i) = ch.boundary[k];
-        for j in 0..N {
-            if new[k].n[j] != CellId::NONE {
-                continue;
-            }
-            let (mut u, mut w) = (old[ci as usize].v[i as usize], new[k].v[j]);
-            let mut cur = ci as usize;
-            loop {
-                let cc = &old[cur];
-                let kw = cc.index_of(w).expect("ridge rotation");
-                match ch.links[cur][kw] {
-                    OUTSIDE => {
-                        let k2 = on_facet[cur][kw] as usize;
-                        let ku = new[k2].index_of(u).expect("ridge rotation");
-                        new[k].n[j] = ids[k2];
-                        new[k2].n[ku] = ids[k];
-                        break;
-                    }
-                    next => {
-                        let nb = &old[next as usize];
-                        let m = nb.mirror(ch.conflict[cur].0).expect("symmetric neighbours");
-                        (w, u) = (u, nb.v[m]);
-                        cur = next as usize;
-                    }
-                }
-            }
+    if N == 3 {
+        // 2D: a fan, in the order of the rim (as [`Engine::star_around`] links it)
+        let m = new.len();
+        for k in 0..m {
+            let next = if k + 1 == m { 0 } else { k + 1 };
+            let sa = slot_in(&new[k].v, ch.rim[k].0, ch.boundary[k].1 as usize);
+            let sb = slot_in(&new[next].v, ch.rim[next].1, ch.boundary[next].1 as usize);
+            new[k].n[sa] = ids[next];
+            new[next].n[sb] = ids[k];
         }
+    } else {
+        link_by_rotation(
+            &ch.conflict,
+            &ch.boundary,
+            &ch.links,
+            old,
+            new,
+            ids,
+            on_facet,
+        );
     }
     for (k, cell) in new.iter().enumerate() {
         let mut cell = *cell;
@@ -859,6 +979,94 @@ unsafe fn commit<S: OrbitSpace<N>, const N: usize>(
         new[0].v,
         space.carry(space.identity(), new[0].off[k]),
     ));
-    (ch.old, ch.new, ch.ids, ch.on_facet, ch.orphans) = (old, new, ids, on_facet, orphans);
     true
+}
+
+/// Adds to `orphans` the vertices `v` of region cell `c` whose cell it is (the commit
+/// points them at a new cell; no other chunk writes their cells meanwhile, since they
+/// point at none of their regions).
+#[inline(always)]
+fn orphans_of<const N: usize>(
+    vcell: &[AtomicU32],
+    c: CellId,
+    v: &[VertexId; N],
+    orphans: &mut Vec<VertexId>,
+) {
+    orphans.extend(v.iter().filter(|&&x| vcell[x.index()].load(Relaxed) == c.0));
+}
+
+/// Links the new cells of a chunk's region around each new ridge by rotating through the
+/// region (its cells as they were in `old`, their links in the chunk), any dimension.
+fn link_by_rotation<O: Copy, const N: usize>(
+    conflict: &[(CellId, O)],
+    boundary: &[(u32, u8)],
+    links: &[[u32; N]],
+    old: &[Cell<O, N>],
+    new: &mut [Cell<O, N>],
+    ids: &[CellId],
+    on_facet: &mut Vec<[u32; N]>,
+) {
+    on_facet.clear();
+    on_facet.resize(old.len(), [u32::MAX; N]);
+    for (k, &(ci, i)) in boundary.iter().enumerate() {
+        on_facet[ci as usize][i as usize] = k as u32;
+    }
+    for k in 0..new.len() {
+        let (ci, i) = boundary[k];
+        for j in 0..N {
+            if new[k].n[j] != CellId::NONE {
+                continue;
+            }
+            let (mut u, mut w) = (old[ci as usize].v[i as usize], new[k].v[j]);
+            let mut cur = ci as usize;
+            loop {
+                let cc = &old[cur];
+                let kw = cc.index_of(w).expect("ridge rotation");
+                match links[cur][kw] {
+                    OUTSIDE => {
+                        let k2 = on_facet[cur][kw] as usize;
+                        let ku = new[k2].index_of(u).expect("ridge rotation");
+                        new[k].n[j] = ids[k2];
+                        new[k2].n[ku] = ids[k];
+                        break;
+                    }
+                    next => {
+                        let nb = &old[next as usize];
+                        let m = nb.mirror(conflict[cur].0).expect("symmetric neighbours");
+                        (w, u) = (u, nb.v[m]);
+                        cur = next as usize;
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Ownership;
+
+    #[test]
+    fn each_chunk_owns_its_cell_stamp_and_visit_marks_and_nothing_else() {
+        let shift = Ownership::shift_for(8, 100);
+        assert_eq!(shift, 8, "201 stamps a chunk round up to 256");
+        let own = Ownership { first: 1000, shift };
+        for j in 0..8 {
+            assert_eq!(own.owner(own.stamp(j)), j);
+            for k in 0..100 {
+                let (inside, outside) = own.visit(j, k).expect("a visit per point");
+                assert_eq!((own.owner(inside), own.owner(outside)), (j, j));
+                assert!(inside != outside && inside != own.stamp(j));
+            }
+            // the marks run out within the chunk's range
+            let last = (0..).find(|&k| own.visit(j, k).is_none()).unwrap();
+            assert_eq!(own.owner(own.visit(j, last - 1).unwrap().1), j);
+        }
+        // older stamps (visits before the pass) and stamps after the last chunk: no owner
+        for s in [0, 1, 999, 1000 + (8 << shift), u32::MAX] {
+            assert!(own.owner(s) >= 8, "stamp {s}");
+        }
+        // huge chunks: capped so that the 8 chunks' stamps fit
+        assert!(8u64 << Ownership::shift_for(8, usize::MAX / 4) <= 1 << 30);
+    }
 }
