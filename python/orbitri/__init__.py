@@ -830,8 +830,8 @@ class PeriodicDelaunay(_Delaunay):
 
     ``threads=N`` builds in parallel on N threads (and runs the construction's other
     steps on N threads); every N gives the same triangulation, stored the same, so every
-    array is the same. The default, ``None``, inserts the points one at a time, which is the
-    fastest on one or two cores (see the README).
+    array is the same. The default, ``None``, inserts the points one at a time: it takes less
+    memory, and two threads take 0.76-0.91x its time on two cores (see the README).
 
     Weighted points (atoms or grains of given radii): ``weights=`` (squared lengths) or
     ``radii=`` give the regular triangulation, whose ``voronoi()`` cells are the power
