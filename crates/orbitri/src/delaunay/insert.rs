@@ -395,9 +395,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                         self.link(nc, j, nb, self.slot(nb, u, ku));
                         break;
                     }
-                    let m = self.tds.cells[nb.index()]
-                        .mirror(cur)
-                        .expect("symmetric neighbours");
+                    let m = self.mirror_of(nb, cur);
                     let xv = self.tds.cells[nb.index()].v[m];
                     w = u;
                     u = xv;

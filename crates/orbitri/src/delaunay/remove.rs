@@ -248,9 +248,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 }
             }
             let d = cell.n[i];
-            let j = self.tds.cells[d.index()]
-                .mirror(c)
-                .expect("symmetric neighbours");
+            let j = self.mirror_of(d, c);
             // a star cell moved by an orientation-reversing element is negatively oriented:
             // two of its facet's vertices change places
             let mut v = cell.v;
