@@ -130,13 +130,13 @@ pub fn hilbert<const D: usize>(mut x: [u32; D], bits: u32) -> u64 {
     h
 }
 
-/// The BRIO insertion order of `keys.len()` items: rounds that double in size (the last
-/// holds about half the items, the first about 64), each sorted by key. An item's round is
-/// drawn from a hash of its index and `seed` (the tails before the first head of a fair
-/// coin, counted back from the last round), so that the rounds are filled in one pass over
-/// the keys in memory order: no shuffle, no lookup of a key at a random place.
-pub fn brio_order(keys: &[u64], seed: u64) -> Vec<u32> {
-    let n = keys.len();
+/// The BRIO rounds of `n` items: their indices grouped by round, in index order within
+/// each, and where each round starts (one entry more: `n`). The rounds double in size (the
+/// last holds about half the items, the first about 64). An item's round is drawn from a
+/// hash of its index and `seed` (the tails before the first head of a fair coin, counted
+/// back from the last round), so that the rounds are filled in one pass over the items in
+/// memory order: no shuffle, no lookup at a random place.
+pub fn brio_rounds(n: usize, seed: u64) -> (Vec<u32>, Vec<usize>) {
     let mut last = 0;
     let mut m = n;
     while m > 64 {
@@ -157,18 +157,60 @@ pub fn brio_order(keys: &[u64], seed: u64) -> Vec<u32> {
     for r in 0..=last {
         start[r + 1] += start[r];
     }
-    let ends = start.clone();
-    let mut pairs = vec![(0u64, 0u32); n];
-    for (i, (&r, &key)) in round.iter().zip(keys).enumerate() {
-        let at = &mut start[r as usize];
-        pairs[*at] = (key, i as u32);
-        *at += 1;
+    let mut at = start.clone();
+    let mut idx = vec![0u32; n];
+    for (i, &r) in round.iter().enumerate() {
+        idx[at[r as usize]] = i as u32;
+        at[r as usize] += 1;
     }
-    for r in 0..=last {
+    (idx, start)
+}
+
+/// The BRIO insertion order of `keys.len()` items ([`brio_rounds`]), each round sorted by
+/// key.
+pub fn brio_order(keys: &[u64], seed: u64) -> Vec<u32> {
+    let (idx, start) = brio_rounds(keys.len(), seed);
+    let mut pairs: Vec<(u64, u32)> = idx.par_iter().map(|&i| (keys[i as usize], i)).collect();
+    for r in start.windows(2) {
         // (the pairs are distinct: the parallel sort gives the same order)
-        pairs[ends[r]..ends[r + 1]].par_sort_unstable();
+        pairs[r[0]..r[1]].par_sort_unstable();
     }
     pairs.into_par_iter().map(|(_, i)| i).collect()
+}
+
+/// Feeds the BRIO rounds of `n` items ([`brio_rounds`]) to `consume` in order, each made
+/// ready by `prepare` (given the round's indices; it sorts them, gathers the items) on a
+/// helper thread while the rounds before it are consumed: the insertion order, a tenth
+/// of a build done up front, hides behind the insertion, which takes ten times longer a
+/// point. Stops at `consume`'s first error.
+pub fn in_rounds<T: Send, E>(
+    n: usize,
+    seed: u64,
+    prepare: impl Fn(&[u32]) -> T + Sync,
+    mut consume: impl FnMut(T) -> Result<(), E>,
+) -> Result<(), E> {
+    let (idx, start) = brio_rounds(n, seed);
+    std::thread::scope(|s| {
+        // (two rounds ahead at most: each is as large as all before it)
+        let (tx, rx) = std::sync::mpsc::sync_channel(1);
+        let (prepare, idx, start) = (&prepare, &idx, &start);
+        s.spawn(move || {
+            for r in start.windows(2) {
+                if tx.send(prepare(&idx[r[0]..r[1]])).is_err() {
+                    return; // the consumer stopped
+                }
+            }
+        });
+        rx.into_iter().try_for_each(&mut consume)
+    })
+}
+
+/// The indices of a BRIO round sorted by `key` (one thread: a round is sorted while
+/// another is inserted), with their keys.
+pub fn sorted_round(idx: &[u32], key: impl Fn(u32) -> u64) -> Vec<(u64, u32)> {
+    let mut pairs: Vec<(u64, u32)> = idx.iter().map(|&i| (key(i), i)).collect();
+    pairs.sort_unstable();
+    pairs
 }
 
 #[cfg(test)]
@@ -306,5 +348,30 @@ mod tests {
             (400..600).contains(&tail),
             "the last round holds {tail} items"
         );
+    }
+
+    #[test]
+    fn rounds_fed_in_order_are_the_brio_order_and_an_error_stops_them() {
+        let keys: Vec<u64> = (0..5000u64).map(|i| (i * 7919) % 5000).collect();
+        let prepare = |idx: &[u32]| sorted_round(idx, |i| keys[i as usize]);
+        let mut fed = Vec::new();
+        let all: Result<(), ()> = in_rounds(keys.len(), 9, prepare, |round| {
+            assert!(round.windows(2).all(|w| w[0] < w[1]), "a sorted round");
+            fed.extend(round.iter().map(|&(_, i)| i));
+            Ok(())
+        });
+        assert!(all.is_ok());
+        assert_eq!(fed, brio_order(&keys, 9));
+        // a consumer that stops after three rounds: the helper stops too (no hang)
+        let mut rounds = 0;
+        let stopped = in_rounds(keys.len(), 9, prepare, |_| {
+            rounds += 1;
+            if rounds == 3 {
+                Err(rounds)
+            } else {
+                Ok(())
+            }
+        });
+        assert_eq!((stopped, rounds), (Err(3), 3));
     }
 }

@@ -485,3 +485,31 @@ fn voronoi_vertices_are_equidistant_and_areas_sum_to_four_pi() {
         }
     }
 }
+
+#[test]
+fn a_build_reports_its_progress_and_stops_when_asked() {
+    // the rounds are sorted on a helper thread while the ones before them are inserted:
+    // the counts rise to the end, and a stop returns at once, the helper with it
+    let pts = random_points(30_000, 8);
+    let mut seen = Vec::new();
+    let tri = SphericalDelaunay::build_with(&pts, |k| {
+        seen.push(k);
+        std::ops::ControlFlow::Continue(())
+    })
+    .unwrap();
+    assert_eq!(tri.number_of_vertices(), 30_000);
+    assert!(seen.windows(2).all(|w| w[0] <= w[1]), "{seen:?}");
+    assert_eq!((seen[0], *seen.last().unwrap()), (0, 30_000));
+    assert!(seen.len() >= 30_000 / 4096, "{} reports", seen.len());
+    let mut last = 0;
+    let stopped = SphericalDelaunay::build_with(&pts, |k| {
+        last = k;
+        if k >= 10_000 {
+            std::ops::ControlFlow::Break(())
+        } else {
+            std::ops::ControlFlow::Continue(())
+        }
+    });
+    assert!(matches!(stopped, Err(Error::Interrupted)));
+    assert!((10_000..20_000).contains(&last), "stopped at {last}");
+}

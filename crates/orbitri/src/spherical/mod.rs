@@ -199,24 +199,17 @@ pub type SphericalDelaunay = SphericalTriangulation<Sphere>;
 /// ([`SphericalTriangulation::face_signs`]).
 pub type ProjectiveDelaunay = SphericalTriangulation<ProjectivePlane>;
 
-/// The stored representatives of `points` with their spatial keys, by index, in BRIO +
-/// Hilbert order; gathered in that order before the insertion loop (independent loads
-/// overlap, where a load inside the loop stalls it: a tenth of the build at 10⁶ points).
-fn insertion_order<S: SphericalSpace>(
+/// The items of a BRIO round of `points` (their indices `idx`, input ids from `first`):
+/// the stored representatives with their spatial keys, sorted along the curve.
+fn round_items<S: SphericalSpace>(
     points: &[[f64; 3]],
-    seed: u64,
+    idx: &[u32],
     first: usize,
 ) -> Vec<Item<[f64; 3]>> {
-    let keys: Vec<u64> = points
-        .par_iter()
-        .map(|&p| sphere_key(&S::representative(p)))
-        .collect();
-    crate::sort::brio_order(&keys, seed)
-        .into_par_iter()
-        .map(|i| {
-            let p = S::representative(points[i as usize]);
-            ((first + i as usize) as u32, p, 0.0, keys[i as usize])
-        })
+    let stored = |i: u32| S::representative(points[i as usize]);
+    crate::sort::sorted_round(idx, |i| sphere_key(&stored(i)))
+        .into_iter()
+        .map(|(key, i)| ((first + i as usize) as u32, stored(i), 0.0, key))
         .collect()
 }
 
@@ -368,7 +361,7 @@ impl<S: SphericalSpace> SphericalTriangulation<S> {
         tri.engine.set_threads(threads);
         tri.engine.reserve(points.len() + 4, 2 * points.len() + 8);
         tri.input_point = vec![PointId::NONE; points.len()];
-        tri.insert_items(&insertion_order::<S>(points, 0x0b17, 0), &mut progress)?;
+        tri.insert_rounds(points, 0x0b17, 0, &mut progress)?;
         if progress(points.len()).is_break() {
             return Err(Error::Interrupted);
         }
@@ -398,9 +391,8 @@ impl<S: SphericalSpace> SphericalTriangulation<S> {
             self.reanchor(points);
         }
         self.input_point.resize(first + points.len(), PointId::NONE);
-        let items = insertion_order::<S>(points, 0x0b17 ^ first as u64, first);
         let unstoppable = &mut |_| ControlFlow::Continue(());
-        self.insert_items(&items, unstoppable)
+        self.insert_rounds(points, 0x0b17 ^ first as u64, first, unstoppable)
             .expect("no progress callback to stop it");
         // (statuses as they are now: a later point may have hidden an earlier one)
         Ok((first..first + points.len())
@@ -443,6 +435,29 @@ impl<S: SphericalSpace> SphericalTriangulation<S> {
         self.record(i, p, r)
     }
 
+    /// Inserts `points` (input ids from `first`, their slots in `input_point` made) in
+    /// BRIO + Hilbert order, a round at a time, each sorted while the one before it is
+    /// inserted ([`crate::sort::in_rounds`]); `Err` if `progress` stopped it.
+    fn insert_rounds(
+        &mut self,
+        points: &[[f64; 3]],
+        seed: u64,
+        first: usize,
+        progress: &mut impl FnMut(usize) -> ControlFlow<()>,
+    ) -> Result<()> {
+        let mut done = 0;
+        crate::sort::in_rounds(
+            points.len(),
+            seed,
+            |idx| round_items::<S>(points, idx, first),
+            |items| {
+                self.insert_items(&items, &mut |k| progress(done + k))?;
+                done += items.len();
+                Ok(())
+            },
+        )
+    }
+
     /// Inserts `items` (tagged with their input ids) by the engine's parallel insertion,
     /// and records each in the engine's order; `Err` if `progress` stopped it.
     fn insert_items(
@@ -454,7 +469,16 @@ impl<S: SphericalSpace> SphericalTriangulation<S> {
         if flow.is_break() {
             return Err(Error::Interrupted);
         }
-        for (k, r, hid) in log.iter() {
+        // (the input ids come in a random order: their slots are loaded ahead)
+        let ahead = |e: usize| {
+            log.events
+                .get(e + 16)
+                .map(|x| items[x.0 as usize].0 as usize)
+        };
+        for (e, (k, r, hid)) in log.iter().enumerate() {
+            if let Some(slot) = ahead(e).and_then(|i| self.input_point.get(i)) {
+                crate::tds::prefetch(slot);
+            }
             self.engine.hidden_log.extend_from_slice(hid);
             let (i, p, _, _) = items[k as usize];
             self.record(InputId(i), p, r);
