@@ -178,22 +178,28 @@ pub fn brio_order(keys: &[u64], seed: u64) -> Vec<u32> {
     pairs.into_par_iter().map(|(_, i)| i).collect()
 }
 
-/// Feeds the BRIO rounds of `n` items ([`brio_rounds`]) to `consume` in order, each made
-/// ready by `prepare` (given the round's indices; it sorts them, gathers the items) on a
-/// helper thread while the rounds before it are consumed: the insertion order, a tenth
-/// of a build done up front, hides behind the insertion, which takes ten times longer a
-/// point. Stops at `consume`'s first error.
+/// Feeds the BRIO rounds of `n` items ([`brio_rounds`] by `seed`; without one, all items
+/// in their order as one round) to `consume` in order, each made ready by `prepare`
+/// (given the round's indices; it sorts them, gathers the items) on a helper thread while
+/// the round before it is consumed: the insertion order, a tenth of a build when done up
+/// front, hides behind the insertion, which takes ten times longer a point. Stops at
+/// `consume`'s first error.
 pub fn in_rounds<T: Send, E>(
     n: usize,
-    seed: u64,
+    seed: Option<u64>,
     prepare: impl Fn(&[u32]) -> T + Sync,
     mut consume: impl FnMut(T) -> Result<(), E>,
 ) -> Result<(), E> {
-    let (idx, start) = brio_rounds(n, seed);
+    let (idx, start) = match seed {
+        Some(seed) => brio_rounds(n, seed),
+        None => ((0..n as u32).collect(), vec![0, n]),
+    };
     std::thread::scope(|s| {
-        // (two rounds ahead at most: each is as large as all before it)
-        let (tx, rx) = std::sync::mpsc::sync_channel(1);
-        let (prepare, idx, start) = (&prepare, &idx, &start);
+        // (a round is made ready while the one before it is consumed, no further ahead:
+        // each is as large as all before it; the helper owns the indices, freed once the
+        // last round is ready)
+        let (tx, rx) = std::sync::mpsc::sync_channel(0);
+        let prepare = &prepare;
         s.spawn(move || {
             for r in start.windows(2) {
                 if tx.send(prepare(&idx[r[0]..r[1]])).is_err() {
@@ -355,7 +361,7 @@ mod tests {
         let keys: Vec<u64> = (0..5000u64).map(|i| (i * 7919) % 5000).collect();
         let prepare = |idx: &[u32]| sorted_round(idx, |i| keys[i as usize]);
         let mut fed = Vec::new();
-        let all: Result<(), ()> = in_rounds(keys.len(), 9, prepare, |round| {
+        let all: Result<(), ()> = in_rounds(keys.len(), Some(9), prepare, |round| {
             assert!(round.windows(2).all(|w| w[0] < w[1]), "a sorted round");
             fed.extend(round.iter().map(|&(_, i)| i));
             Ok(())
@@ -364,7 +370,7 @@ mod tests {
         assert_eq!(fed, brio_order(&keys, 9));
         // a consumer that stops after three rounds: the helper stops too (no hang)
         let mut rounds = 0;
-        let stopped = in_rounds(keys.len(), 9, prepare, |_| {
+        let stopped = in_rounds(keys.len(), Some(9), prepare, |_| {
             rounds += 1;
             if rounds == 3 {
                 Err(rounds)

@@ -448,7 +448,7 @@ impl<S: SphericalSpace> SphericalTriangulation<S> {
         let mut done = 0;
         crate::sort::in_rounds(
             points.len(),
-            seed,
+            Some(seed),
             |idx| round_items::<S>(points, idx, first),
             |items| {
                 self.insert_items(&items, &mut |k| progress(done + k))?;

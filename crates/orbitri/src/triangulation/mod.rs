@@ -174,35 +174,6 @@ fn internal_points<const D: usize, const N: usize, S: FlatSpace<D, N>>(
     Ok((out, moved))
 }
 
-/// The BRIO + Hilbert insertion order of internal points, and their spatial keys (which
-/// the engine's point location uses too).
-fn spatial_order<const D: usize, const N: usize, S: FlatSpace<D, N>>(
-    space: &S,
-    points: &[[f64; D]],
-    seed: u64,
-) -> (Vec<u32>, Vec<u64>) {
-    let keys: Vec<u64> = points.par_iter().map(|p| space.spatial_key(p)).collect();
-    (crate::sort::brio_order(&keys, seed), keys)
-}
-
-/// The engine's items of internal points in insertion `order`: tagged with their input ids
-/// (`first` + index), with their weights (none: unweighted) and spatial keys.
-fn items<const D: usize>(
-    points: &[[f64; D]],
-    weights: &[f64],
-    (order, keys): (&[u32], &[u64]),
-    first: usize,
-) -> Vec<Item<[f64; D]>> {
-    order
-        .par_iter()
-        .map(|&k| {
-            let k = k as usize;
-            let w = weights.get(k).copied().unwrap_or(0.0);
-            ((first + k) as u32, points[k], w, keys[k])
-        })
-        .collect()
-}
-
 /// The indices of internal points in Hilbert order (a batch of moves or queries: each
 /// next one near the previous).
 fn hilbert_order<const D: usize, const N: usize, S: FlatSpace<D, N>>(
@@ -294,12 +265,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         }
         let space = empty.space().clone();
         let (wrapped_pts, wrapped) = internal_points(&space, points)?;
-        let (order, keys) = if opts.spatial_sort {
-            spatial_order(&space, &wrapped_pts, opts.seed)
-        } else {
-            let keys = wrapped_pts.iter().map(|p| space.spatial_key(p)).collect();
-            ((0..points.len() as u32).collect(), keys)
-        };
+        let seed = opts.spatial_sort.then_some(opts.seed);
         let fresh = || {
             let mut tri = empty.emptied();
             tri.wrapped = wrapped;
@@ -313,7 +279,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         tri.engine
             .reserve(points.len() + 128, points.len() * per_point / 4 + 4096);
         if points.len() >= opts.dummy_threshold
-            && tri.build_from_dummies(&wrapped_pts, weights, (&order, &keys), &mut progress)?
+            && tri.build_from_dummies(&wrapped_pts, weights, seed, &mut progress)?
         {
             tri.represent_first_occurrences(&wrapped_pts);
             return Ok(tri);
@@ -321,13 +287,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         let mut tri = fresh();
         tri.engine.set_threads(opts.threads);
         tri.input_point = vec![PointId::NONE; points.len()];
-        tri.insert_ordered(
-            (&wrapped_pts, weights),
-            (&order, &keys),
-            0,
-            &mut progress,
-            |_, _| true,
-        )?;
+        tri.insert_ordered((&wrapped_pts, weights), seed, 0, &mut progress, |_, _| true)?;
         if !tri.engine.is_one_sheeted() {
             tri.engine.try_one_sheet();
         }
@@ -367,7 +327,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         &mut self,
         pts: &[[f64; D]],
         weights: &[f64],
-        (order, keys): (&[u32], &[u64]),
+        seed: Option<u64>,
         progress: &mut impl FnMut(usize) -> ControlFlow<()>,
     ) -> Result<bool> {
         let dummies = self.engine.space().dummy_points();
@@ -388,16 +348,10 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         self.point_input = vec![InputId::NONE; k as usize];
         // (a dummy hidden by a point on it, of a larger weight, or a point on a dummy: start
         // again without)
-        let kept = self.insert_ordered(
-            (pts, weights),
-            (order, keys),
-            0,
-            progress,
-            |r, hid| match r {
-                Inserted::Duplicate(p) => p.0 >= k,
-                _ => hid.iter().all(|h| h.id.0 >= k),
-            },
-        )?;
+        let kept = self.insert_ordered((pts, weights), seed, 0, progress, |r, hid| match r {
+            Inserted::Duplicate(p) => p.0 >= k,
+            _ => hid.iter().all(|h| h.id.0 >= k),
+        })?;
         if !kept {
             return Ok(false);
         }
@@ -445,28 +399,72 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         }
     }
 
-    /// Inserts internal `points` (with `weights`, none when unweighted) in `order`, point
-    /// `k` as input `first + k`, and records each in the engine's order while `keep(result,
-    /// points it hid)` holds: false when one does not (the rest unrecorded), `Err` if
-    /// `progress` stopped it. One at a time unless the engine has threads: the parallel
-    /// insertion's items and log cost 56 bytes a point more at the peak (435 → 498 MB for
-    /// 10⁶ points in a cube), which one at a time need not pay.
+    /// Inserts internal `points` (with `weights`, none when unweighted), point `k` as
+    /// input `first + k`, in BRIO + Hilbert order by `seed` (without one, in their order), a
+    /// round at a time, each sorted on a helper thread while the ones before it are
+    /// inserted ([`crate::sort::in_rounds`]); records each in the engine's order while
+    /// `keep(result, points it hid)` holds: false when one does not (the rest unrecorded),
+    /// `Err` if `progress` stopped it.
     fn insert_ordered(
         &mut self,
         (points, weights): (&[[f64; D]], &[f64]),
-        (order, keys): (&[u32], &[u64]),
+        seed: Option<u64>,
         first: usize,
         progress: &mut impl FnMut(usize) -> ControlFlow<()>,
         keep: impl Fn(Inserted, &[HiddenPoint<[f64; D]>]) -> bool,
     ) -> Result<bool> {
+        let space = self.space().clone();
+        let prepare = |idx: &[u32]| {
+            let key = |k: u32| space.spatial_key(&points[k as usize]);
+            match seed {
+                Some(_) => crate::sort::sorted_round(idx, key),
+                None => idx.iter().map(|&k| (key(k), k)).collect(),
+            }
+        };
+        let mut done = 0;
+        let outcome = crate::sort::in_rounds(points.len(), seed, prepare, |round| {
+            let at = (first, done);
+            match self.insert_round((points, weights), &round, at, progress, &keep) {
+                Ok(true) => {
+                    done += round.len();
+                    Ok(())
+                }
+                Ok(false) => Err(None),
+                Err(e) => Err(Some(e)),
+            }
+        });
+        match outcome {
+            Ok(()) => Ok(true),
+            Err(None) => Ok(false),
+            Err(Some(e)) => Err(e),
+        }
+    }
+
+    /// [`Self::insert_ordered`] of one round, `(spatial key, index)` pairs in insertion
+    /// order, after `done` points. One at a time unless the engine has threads: the
+    /// parallel insertion's items and log cost 56 bytes a point more at the peak (435 →
+    /// 498 MB for 10⁶ points in a cube), which one at a time need not pay.
+    fn insert_round(
+        &mut self,
+        (points, weights): (&[[f64; D]], &[f64]),
+        round: &[(u64, u32)],
+        (first, done): (usize, usize),
+        progress: &mut impl FnMut(usize) -> ControlFlow<()>,
+        keep: &impl Fn(Inserted, &[HiddenPoint<[f64; D]>]) -> bool,
+    ) -> Result<bool> {
+        let weight = |k: usize| weights.get(k).copied().unwrap_or(0.0);
         if self.engine.threads().is_none() {
-            for (n, &k) in order.iter().enumerate() {
-                if n % 4096 == 0 {
-                    proceed(progress, n)?;
+            for (n, &(key, k)) in round.iter().enumerate() {
+                if (done + n) % 4096 == 0 {
+                    proceed(progress, done + n)?;
+                }
+                // (the points come in a random order: loaded ahead)
+                if let Some(&(_, ahead)) = round.get(n + 8) {
+                    crate::tds::prefetch(&points[ahead as usize]);
                 }
                 let k = k as usize;
-                let (p, w) = (points[k], weights.get(k).copied().unwrap_or(0.0));
-                let r = self.engine.insert_keyed(p, w, keys[k]);
+                let (p, w) = (points[k], weight(k));
+                let r = self.engine.insert_keyed(p, w, key);
                 if !keep(r, &self.engine.hidden_log) {
                     return Ok(false);
                 }
@@ -474,8 +472,16 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             }
             return Ok(true);
         }
-        let items = items(points, weights, (order, keys), first);
-        let (log, flow) = self.engine.insert_parallel(&items, &mut *progress);
+        let items: Vec<Item<[f64; D]>> = round
+            .par_iter()
+            .map(|&(key, k)| {
+                let k = k as usize;
+                ((first + k) as u32, points[k], weight(k), key)
+            })
+            .collect();
+        let (log, flow) = self
+            .engine
+            .insert_parallel(&items, &mut |n| progress(done + n));
         if flow.is_break() {
             return Err(Error::Interrupted);
         }
@@ -537,11 +543,10 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         self.input_point
             .resize(first + internal.len(), PointId::NONE);
         let seed = BuildOptions::default().seed ^ first as u64;
-        let (order, keys) = spatial_order(self.space(), internal, seed);
         let unstoppable = &mut |_| ControlFlow::Continue(());
         let done = self.insert_ordered(
             (internal, weights),
-            (&order, &keys),
+            Some(seed),
             first,
             unstoppable,
             |_, _| true,
