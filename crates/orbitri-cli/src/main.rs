@@ -1006,6 +1006,7 @@ fn number(s: &str) -> Result<f64, String> {
 }
 
 fn main() -> ExitCode {
+    rss::keep_large_buffers_mapped();
     let cli = Cli::parse_from(mark_negative_numbers(std::env::args_os()));
     if let Some(n) = cli.threads {
         let _ = THREADS.set(n.into());
