@@ -183,7 +183,7 @@ pub fn brio_order(keys: &[u64], seed: u64) -> Vec<u32> {
 /// (given the round's indices; it sorts them, gathers the items) on a helper thread while
 /// the round before it is consumed: the insertion order, a tenth of a build when done up
 /// front, hides behind the insertion, which takes ten times longer a point. Stops at
-/// `consume`'s first error.
+/// `consume`'s first error. (Below 2¹⁴ items, all on the caller's thread.)
 pub fn in_rounds<T: Send, E>(
     n: usize,
     seed: Option<u64>,
@@ -194,6 +194,12 @@ pub fn in_rounds<T: Send, E>(
         Some(seed) => brio_rounds(n, seed),
         None => ((0..n as u32).collect(), vec![0, n]),
     };
+    if n < 1 << 14 {
+        // (small: sorting takes less than starting a thread)
+        return start
+            .windows(2)
+            .try_for_each(|r| consume(prepare(&idx[r[0]..r[1]])));
+    }
     std::thread::scope(|s| {
         // (a round is made ready while the one before it is consumed, no further ahead:
         // each is as large as all before it; the helper owns the indices, freed once the
@@ -358,7 +364,14 @@ mod tests {
 
     #[test]
     fn rounds_fed_in_order_are_the_brio_order_and_an_error_stops_them() {
-        let keys: Vec<u64> = (0..5000u64).map(|i| (i * 7919) % 5000).collect();
+        // 5000 items: on the caller's thread; 40 000: on the helper thread
+        for n in [5000u64, 40_000] {
+            rounds_in_order(n);
+        }
+    }
+
+    fn rounds_in_order(n: u64) {
+        let keys: Vec<u64> = (0..n).map(|i| (i * 7919) % n).collect();
         let prepare = |idx: &[u32]| sorted_round(idx, |i| keys[i as usize]);
         let mut fed = Vec::new();
         let all: Result<(), ()> = in_rounds(keys.len(), Some(9), prepare, |round| {
