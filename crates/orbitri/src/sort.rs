@@ -166,63 +166,52 @@ pub fn brio_rounds(n: usize, seed: u64) -> (Vec<u32>, Vec<usize>) {
     (idx, start)
 }
 
-/// The BRIO insertion order of `keys.len()` items ([`brio_rounds`]), each round sorted by
-/// key.
-pub fn brio_order(keys: &[u64], seed: u64) -> Vec<u32> {
-    let (idx, start) = brio_rounds(keys.len(), seed);
-    let mut pairs: Vec<(u64, u32)> = idx.par_iter().map(|&i| (keys[i as usize], i)).collect();
-    for r in start.windows(2) {
-        // (the pairs are distinct: the parallel sort gives the same order)
-        pairs[r[0]..r[1]].par_sort_unstable();
-    }
-    pairs.into_par_iter().map(|(_, i)| i).collect()
-}
-
-/// Feeds the BRIO rounds of `n` items ([`brio_rounds`] by `seed`; without one, all items
-/// in their order as one round) to `consume` in order, each made ready by `prepare`
-/// (given the round's indices; it sorts them, gathers the items) on a helper thread while
-/// the round before it is consumed: the insertion order, a tenth of a build when done up
-/// front, hides behind the insertion, which takes ten times longer a point. Stops at
-/// `consume`'s first error. (Below 2¹⁴ items, all on the caller's thread.)
+/// Feeds the BRIO rounds of `n` items ([`brio_rounds`] by `seed`) to `consume` in order,
+/// each as `(key, index)` pairs sorted by `key` and made ready by `prepare` (it gathers the
+/// items) on a helper thread while the round before it is consumed: the insertion order,
+/// a tenth of a build when done up front, hides behind the insertion, which takes ten
+/// times longer a point. Without a seed, all items in their order as one round, unsorted.
+/// Stops at `consume`'s first error. (Below 2¹⁴ items, all on the caller's thread.)
 pub fn in_rounds<T: Send, E>(
     n: usize,
     seed: Option<u64>,
-    prepare: impl Fn(&[u32]) -> T + Sync,
+    key: impl Fn(u32) -> u64 + Sync,
+    prepare: impl Fn(Vec<(u64, u32)>) -> T + Sync,
     mut consume: impl FnMut(T) -> Result<(), E>,
 ) -> Result<(), E> {
     let (idx, start) = match seed {
         Some(seed) => brio_rounds(n, seed),
         None => ((0..n as u32).collect(), vec![0, n]),
     };
+    // (one thread: a round is sorted while another is inserted)
+    let ready = |round: &[u32]| {
+        let mut pairs: Vec<(u64, u32)> = round.iter().map(|&i| (key(i), i)).collect();
+        if seed.is_some() {
+            pairs.sort_unstable();
+        }
+        prepare(pairs)
+    };
     if n < 1 << 14 {
         // (small: sorting takes less than starting a thread)
         return start
             .windows(2)
-            .try_for_each(|r| consume(prepare(&idx[r[0]..r[1]])));
+            .try_for_each(|r| consume(ready(&idx[r[0]..r[1]])));
     }
     std::thread::scope(|s| {
         // (a round is made ready while the one before it is consumed, no further ahead:
         // each is as large as all before it; the helper owns the indices, freed once the
         // last round is ready)
         let (tx, rx) = std::sync::mpsc::sync_channel(0);
-        let prepare = &prepare;
+        let ready = &ready;
         s.spawn(move || {
             for r in start.windows(2) {
-                if tx.send(prepare(&idx[r[0]..r[1]])).is_err() {
+                if tx.send(ready(&idx[r[0]..r[1]])).is_err() {
                     return; // the consumer stopped
                 }
             }
         });
         rx.into_iter().try_for_each(&mut consume)
     })
-}
-
-/// The indices of a BRIO round sorted by `key` (one thread: a round is sorted while
-/// another is inserted), with their keys.
-pub fn sorted_round(idx: &[u32], key: impl Fn(u32) -> u64) -> Vec<(u64, u32)> {
-    let mut pairs: Vec<(u64, u32)> = idx.iter().map(|&i| (key(i), i)).collect();
-    pairs.sort_unstable();
-    pairs
 }
 
 #[cfg(test)]
@@ -334,10 +323,27 @@ mod tests {
             .all(|w| w[0][0].abs_diff(w[1][0]) + w[0][1].abs_diff(w[1][1]) == 1));
     }
 
+    /// The indices of `keys` in the order [`in_rounds`] feeds them.
+    fn fed_order(keys: &[u64], seed: u64) -> Vec<u32> {
+        let mut fed = Vec::new();
+        let all: Result<(), ()> = in_rounds(
+            keys.len(),
+            Some(seed),
+            |i| keys[i as usize],
+            |round| round,
+            |round| {
+                fed.extend(round.iter().map(|&(_, i)| i));
+                Ok(())
+            },
+        );
+        assert!(all.is_ok());
+        fed
+    }
+
     #[test]
     fn brio_is_a_permutation_with_sorted_rounds() {
         let keys: Vec<u64> = (0..1000u64).map(|i| (i * 7919) % 1000).collect();
-        let order = brio_order(&keys, 3);
+        let order = fed_order(&keys, 3);
         let mut seen = order.clone();
         seen.sort_unstable();
         assert_eq!(seen, (0..1000).collect::<Vec<u32>>());
@@ -363,7 +369,7 @@ mod tests {
     }
 
     #[test]
-    fn rounds_fed_in_order_are_the_brio_order_and_an_error_stops_them() {
+    fn rounds_fed_in_order_are_the_sorted_rounds_and_an_error_stops_them() {
         // 5000 items: on the caller's thread; 40 000: on the helper thread
         for n in [5000u64, 40_000] {
             rounds_in_order(n);
@@ -372,25 +378,46 @@ mod tests {
 
     fn rounds_in_order(n: u64) {
         let keys: Vec<u64> = (0..n).map(|i| (i * 7919) % n).collect();
-        let prepare = |idx: &[u32]| sorted_round(idx, |i| keys[i as usize]);
-        let mut fed = Vec::new();
-        let all: Result<(), ()> = in_rounds(keys.len(), Some(9), prepare, |round| {
-            assert!(round.windows(2).all(|w| w[0] < w[1]), "a sorted round");
-            fed.extend(round.iter().map(|&(_, i)| i));
-            Ok(())
-        });
-        assert!(all.is_ok());
-        assert_eq!(fed, brio_order(&keys, 9));
+        // each round of `brio_rounds`, sorted by key here
+        let (idx, start) = brio_rounds(keys.len(), 9);
+        let mut expected = Vec::new();
+        for r in start.windows(2) {
+            let mut round = idx[r[0]..r[1]].to_vec();
+            round.sort_by_key(|&i| keys[i as usize]);
+            expected.extend(round);
+        }
+        assert_eq!(fed_order(&keys, 9), expected);
         // a consumer that stops after three rounds: the helper stops too (no hang)
         let mut rounds = 0;
-        let stopped = in_rounds(keys.len(), Some(9), prepare, |_| {
-            rounds += 1;
-            if rounds == 3 {
-                Err(rounds)
-            } else {
-                Ok(())
-            }
-        });
+        let stopped = in_rounds(
+            keys.len(),
+            Some(9),
+            |i| keys[i as usize],
+            |round| round,
+            |_| {
+                rounds += 1;
+                if rounds == 3 {
+                    Err(rounds)
+                } else {
+                    Ok(())
+                }
+            },
+        );
         assert_eq!((stopped, rounds), (Err(3), 3));
+        // without a seed: one round, in index order
+        let mut fed = Vec::new();
+        let plain: Result<(), ()> = in_rounds(
+            keys.len(),
+            None,
+            |i| keys[i as usize],
+            |round| round,
+            |round| {
+                fed.push(round);
+                Ok(())
+            },
+        );
+        assert!(plain.is_ok());
+        let one: Vec<(u64, u32)> = (0..n as u32).map(|i| (keys[i as usize], i)).collect();
+        assert_eq!(fed, vec![one]);
     }
 }

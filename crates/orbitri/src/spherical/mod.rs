@@ -199,20 +199,6 @@ pub type SphericalDelaunay = SphericalTriangulation<Sphere>;
 /// ([`SphericalTriangulation::face_signs`]).
 pub type ProjectiveDelaunay = SphericalTriangulation<ProjectivePlane>;
 
-/// The items of a BRIO round of `points` (their indices `idx`, input ids from `first`):
-/// the stored representatives with their spatial keys, sorted along the curve.
-fn round_items<S: SphericalSpace>(
-    points: &[[f64; 3]],
-    idx: &[u32],
-    first: usize,
-) -> Vec<Item<[f64; 3]>> {
-    let stored = |i: u32| S::representative(points[i as usize]);
-    crate::sort::sorted_round(idx, |i| sphere_key(&stored(i)))
-        .into_iter()
-        .map(|(key, i)| ((first + i as usize) as u32, stored(i), 0.0, key))
-        .collect()
-}
-
 /// The space with the first anchor set that none of `points` meets.
 fn anchors_for<S: SphericalSpace>(points: &[[f64; 3]]) -> S {
     (0..)
@@ -446,10 +432,18 @@ impl<S: SphericalSpace> SphericalTriangulation<S> {
         progress: &mut impl FnMut(usize) -> ControlFlow<()>,
     ) -> Result<()> {
         let mut done = 0;
+        let stored = |i: u32| S::representative(points[i as usize]);
         crate::sort::in_rounds(
             points.len(),
             Some(seed),
-            |idx| round_items::<S>(points, idx, first),
+            |i| sphere_key(&stored(i)),
+            // the stored representatives, gathered with their keys
+            |round| -> Vec<Item<[f64; 3]>> {
+                round
+                    .into_iter()
+                    .map(|(key, i)| ((first + i as usize) as u32, stored(i), 0.0, key))
+                    .collect()
+            },
             |items| {
                 self.insert_items(&items, &mut |k| progress(done + k))?;
                 done += items.len();

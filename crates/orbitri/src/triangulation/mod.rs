@@ -414,25 +414,25 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         keep: impl Fn(Inserted, &[HiddenPoint<[f64; D]>]) -> bool,
     ) -> Result<bool> {
         let space = self.space().clone();
-        let prepare = |idx: &[u32]| {
-            let key = |k: u32| space.spatial_key(&points[k as usize]);
-            match seed {
-                Some(_) => crate::sort::sorted_round(idx, key),
-                None => idx.iter().map(|&k| (key(k), k)).collect(),
-            }
-        };
+        let key = |k: u32| space.spatial_key(&points[k as usize]);
         let mut done = 0;
-        let outcome = crate::sort::in_rounds(points.len(), seed, prepare, |round| {
-            let at = (first, done);
-            match self.insert_round((points, weights), &round, at, progress, &keep) {
-                Ok(true) => {
-                    done += round.len();
-                    Ok(())
+        let outcome = crate::sort::in_rounds(
+            points.len(),
+            seed,
+            key,
+            |round| round,
+            |round| {
+                let at = (first, done);
+                match self.insert_round((points, weights), &round, at, progress, &keep) {
+                    Ok(true) => {
+                        done += round.len();
+                        Ok(())
+                    }
+                    Ok(false) => Err(None),
+                    Err(e) => Err(Some(e)),
                 }
-                Ok(false) => Err(None),
-                Err(e) => Err(Some(e)),
-            }
-        });
+            },
+        );
         match outcome {
             Ok(()) => Ok(true),
             Err(None) => Ok(false),
