@@ -105,3 +105,62 @@ fn absurd_picture_options_are_typed_errors_before_any_output() {
     );
     assert!(out.is_empty());
 }
+
+/// A cell as the `cells` file writes it: input ids, then offsets.
+type Row = (Vec<u32>, Vec<i32>);
+
+/// The `cells` file, read back: its header and one (input ids, offsets) row per line.
+fn read_cells(text: &str) -> ([usize; 3], Vec<Row>) {
+    let mut lines = text.lines();
+    let head: Vec<usize> = lines
+        .next()
+        .unwrap()
+        .split(' ')
+        .map(|x| x.parse().unwrap())
+        .collect();
+    let rows = lines
+        .map(|l| {
+            let x: Vec<i64> = l.split(' ').map(|x| x.parse().unwrap()).collect();
+            let ids = x[..3].iter().map(|&v| v as u32).collect();
+            (ids, x[3..].iter().map(|&v| v as i32).collect())
+        })
+        .collect();
+    ([head[0], head[1], head[2]], rows)
+}
+
+#[test]
+fn the_cells_file_lists_the_complex_in_a_covering_and_in_one_sheet() {
+    // five points stay in a covering; a thousand reach one sheet
+    let many: Vec<[f64; 2]> = (0..1000)
+        .map(|i| {
+            let t = i as f64;
+            [
+                (t * 0.618_033_988_75).fract(),
+                (t * 0.414_213_562_37).fract(),
+            ]
+        })
+        .collect();
+    let big = PeriodicDelaunay2::build(FlatTorus2::cuboid([1.0, 1.0]).unwrap(), &many).unwrap();
+    let small = square();
+    assert!(!small.is_one_sheeted() && big.is_one_sheeted());
+    for tri in [small, big] {
+        let mut out = Vec::new();
+        orbitri::io::write_cells(&mut out, &tri).unwrap();
+        let (head, rows) = read_cells(&String::from_utf8(out).unwrap());
+        let complex = tri.complex().unwrap();
+        assert_eq!(
+            head,
+            [tri.sheets(), tri.number_of_vertices(), complex.cells.len()]
+        );
+        let want: Vec<Row> = complex
+            .cells
+            .iter()
+            .map(|c| {
+                let ids = c.vertices.iter().map(|v| v.0).collect();
+                let off = c.offsets.iter().flatten().map(|&o| i32::from(o)).collect();
+                (ids, off)
+            })
+            .collect();
+        assert_eq!(rows, want);
+    }
+}

@@ -5,7 +5,7 @@ use std::io::Write;
 use super::format::SpaceFormat;
 use crate::ids::InputId;
 use crate::space::FlatSpace;
-use crate::triangulation::Triangulation;
+use crate::triangulation::{CellView, Triangulation};
 
 /// The `cells` format: `SHEETS V C`, then per cell of the space (one per orbit:
 /// [`Triangulation::complex`], also while the triangulation is stored in a covering of
@@ -17,14 +17,9 @@ pub fn write_cells<const D: usize, const N: usize, S: SpaceFormat<D, N>>(
     w: &mut impl Write,
     tri: &Triangulation<D, N, S>,
 ) -> std::io::Result<()> {
-    let cells = complex_of(tri)?.cells;
-    writeln!(
-        w,
-        "{} {} {}",
-        tri.sheets(),
-        tri.number_of_vertices(),
-        cells.len()
-    )?;
+    let cells = cells_of(tri)?;
+    let count = tri.number_of_cells();
+    writeln!(w, "{} {} {}", tri.sheets(), tri.number_of_vertices(), count)?;
     // integers through `itoa` into one reused line buffer: `write!` formatting took longer
     // than the triangulation itself
     let mut num = itoa::Buffer::new();
@@ -53,6 +48,19 @@ pub(super) fn complex_of<const D: usize, const N: usize, S: FlatSpace<D, N>>(
 ) -> std::io::Result<crate::Complex<D, N, S::Elem>> {
     tri.complex()
         .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e.to_string()))
+}
+
+/// The cells of [`Triangulation::complex`], in its order, without its neighbour tables:
+/// read one at a time from the stored cells once the triangulation is 1-sheeted (a copy
+/// of the complex of 10⁶ points in a cube would take ~0.9 GB), else from the complex.
+pub(super) fn cells_of<'a, const D: usize, const N: usize, S: FlatSpace<D, N>>(
+    tri: &'a Triangulation<D, N, S>,
+) -> std::io::Result<Box<dyn Iterator<Item = CellView<D, N, S::Elem>> + 'a>> {
+    Ok(if tri.is_one_sheeted() {
+        Box::new(tri.stored_cells())
+    } else {
+        Box::new(complex_of(tri)?.cells.into_iter())
+    })
 }
 
 /// A JSON number: the shortest representation that reads back to the same double, or
