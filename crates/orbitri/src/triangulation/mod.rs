@@ -9,6 +9,7 @@ mod weighted;
 
 pub use complex::Complex;
 
+use std::borrow::Cow;
 use std::collections::{BTreeMap, HashSet};
 use std::ops::ControlFlow;
 
@@ -159,17 +160,30 @@ fn internal_point<const D: usize, const N: usize, S: FlatSpace<D, N>>(
 }
 
 /// Every point of `points` in the internal frame, wrapped (an error names the first bad
-/// one by its index in `points`), and how many wrapping moved.
-fn internal_points<const D: usize, const N: usize, S: FlatSpace<D, N>>(
+/// one by its index in `points`), and how many wrapping moved. Borrowed when every point is
+/// already internal and in place (a unit box's points inside it): a copy of 10⁶ points in
+/// 3D is 24 MB of a build's peak.
+fn internal_points<'a, const D: usize, const N: usize, S: FlatSpace<D, N>>(
     space: &S,
-    points: &[[f64; D]],
-) -> Result<(Vec<[f64; D]>, usize)> {
-    let mut out = Vec::with_capacity(points.len());
+    points: &'a [[f64; D]],
+) -> Result<(Cow<'a, [[f64; D]]>, usize)> {
+    let same =
+        |a: &[f64; D], b: &[f64; D]| a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits());
+    let mut out: Cow<'a, [[f64; D]]> = Cow::Borrowed(points);
     let mut moved = 0;
     for (i, p) in points.iter().enumerate() {
         let (w, m) = internal_point(space, i, p)?;
         moved += m as usize;
-        out.push(w);
+        match &mut out {
+            Cow::Borrowed(_) if same(&w, p) => {}
+            Cow::Borrowed(_) => {
+                let mut copy = Vec::with_capacity(points.len());
+                copy.extend_from_slice(&points[..i]);
+                copy.push(w);
+                out = Cow::Owned(copy);
+            }
+            Cow::Owned(copy) => copy.push(w),
+        }
     }
     Ok((out, moved))
 }
@@ -1163,4 +1177,33 @@ fn canonical<
         v.iter().map(|&x| x.into()).zip(o.iter().copied()).collect();
     space.canonical_face(&mut pairs);
     pairs.into_iter().map(|(x, g)| (I::from(x), g)).unzip()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn internal_points_are_borrowed_only_when_every_one_is_in_place() {
+        let unit = FlatTorus::<2>::cuboid([1.0, 1.0]).unwrap();
+        let inside = [[0.25, 0.5], [0.0, 0.75]];
+        let (p, moved) = internal_points(&unit, &inside).unwrap();
+        assert!(matches!(p, Cow::Borrowed(_)) && moved == 0);
+        assert_eq!(&*p, &inside);
+        // wrapped, or -0.0 made +0.0: a copy, the points before it included
+        for (bad, want) in [([1.25, 0.5], [0.25, 0.5]), ([-0.0, 0.5], [0.0, 0.5])] {
+            let pts = [[0.25, 0.5], bad, [0.0, 0.75]];
+            let (p, _) = internal_points(&unit, &pts).unwrap();
+            assert!(matches!(p, Cow::Owned(_)));
+            assert_eq!(&*p, &[[0.25, 0.5], want, [0.0, 0.75]]);
+            assert_eq!(p[1][0].to_bits(), want[0].to_bits());
+        }
+        // another box scales into the internal frame: a copy
+        let ten = FlatTorus::<2>::cuboid([10.0, 10.0]).unwrap();
+        let (p, _) = internal_points(&ten, &inside).unwrap();
+        assert!(matches!(p, Cow::Owned(_)));
+        assert_eq!(p[0], [0.25 / 8.0, 0.5 / 8.0]);
+        let err = internal_points(&unit, &[[0.5, 0.5], [f64::NAN, 0.5]]).unwrap_err();
+        assert!(matches!(err, Error::NonFiniteCoordinate { index: 1, .. }));
+    }
 }
