@@ -47,6 +47,9 @@ const SEQUENTIAL_START: usize = 2048;
 const CHUNKS: usize = 8;
 /// Cell slots reserved for a chunk beyond its points' share.
 const MARGIN: usize = 64;
+
+/// Visit marks a point in 3D ([`Ownership`]): an outside one and one a region cell.
+const MARKS_3D: usize = 64;
 /// Every this many points of a chunk, one is located before the pass, to walk from (the
 /// others walk from the chunk's last insertion): walks that keep failing, from cells of the
 /// chunk cut off by others', start afresh there.
@@ -106,72 +109,8 @@ enum Outcome {
     Alone,
 }
 
-/// A small hash map from cell ids to their place in the region (`OUTSIDE` for a cell across
-/// its boundary), cleared in time proportional to its entries.
-#[derive(Debug)]
-struct Marks {
-    keys: Vec<CellId>,
-    values: Vec<u32>,
-    used: Vec<u32>,
-}
-
+/// The link of a region cell's facet to no region cell (see [`Chunk::links`]).
 const OUTSIDE: u32 = u32::MAX;
-
-impl Marks {
-    fn new() -> Self {
-        Marks {
-            keys: vec![CellId::NONE; 256],
-            values: vec![0; 256],
-            used: Vec::new(),
-        }
-    }
-
-    #[inline]
-    fn slot_of(&self, c: CellId) -> usize {
-        let mask = self.keys.len() - 1;
-        let mut h = (c.0.wrapping_mul(0x9E37_79B1) >> 7) as usize & mask;
-        while self.keys[h] != c && self.keys[h] != CellId::NONE {
-            h = (h + 1) & mask;
-        }
-        h
-    }
-
-    #[inline]
-    fn get(&self, c: CellId) -> Option<u32> {
-        let h = self.slot_of(c);
-        (self.keys[h] == c).then(|| self.values[h])
-    }
-
-    fn insert(&mut self, c: CellId, value: u32) {
-        if 2 * (self.used.len() + 1) > self.keys.len() {
-            let entries: Vec<(CellId, u32)> = self
-                .used
-                .iter()
-                .map(|&h| (self.keys[h as usize], self.values[h as usize]))
-                .collect();
-            let size = 2 * self.keys.len();
-            *self = Marks {
-                keys: vec![CellId::NONE; size],
-                values: vec![0; size],
-                used: Vec::new(),
-            };
-            for (k, v) in entries {
-                self.insert(k, v);
-            }
-        }
-        let h = self.slot_of(c);
-        self.keys[h] = c;
-        self.values[h] = value;
-        self.used.push(h as u32);
-    }
-
-    fn clear(&mut self) {
-        for &h in &self.used {
-            self.keys[h as usize] = CellId::NONE;
-        }
-        self.used.clear();
-    }
-}
 
 /// A chunk of a pass: its points (`range`, positions in the wave), the cell slots it may
 /// fill, its last insertion, and what the probe found for its current point.
@@ -196,11 +135,10 @@ struct Chunk<O, const N: usize> {
     across: Vec<(CellId, u8)>,
     /// Per region cell and facet: the index of the region cell across, or `OUTSIDE`.
     links: Vec<[u32; N]>,
-    marks: Marks,
-    /// 2D: the visits made (marks from the chunk's stamps), the boundary edges' ends in
-    /// the order of a walk around the region with the facet across, and the search's stack
-    /// (see [`Engine::probe_around`]).
-    visits: u32,
+    /// The visit marks taken so far from the chunk's stamps ([`Ownership::mark`]).
+    marks: u32,
+    /// 2D: the boundary edges' ends in the order of a walk around the region with the
+    /// facet across, and the search's stack (see [`Engine::probe_around`]).
     rim: Vec<(VertexId, VertexId, u8)>,
     stack: Vec<Frame>,
     /// Free slots for the chunk's new cells: freed ones first (its regions' leftovers),
@@ -231,8 +169,7 @@ impl<O, const N: usize> Chunk<O, N> {
             boundary: Vec::new(),
             across: Vec::new(),
             links: Vec::new(),
-            marks: Marks::new(),
-            visits: 0,
+            marks: 0,
             rim: Vec::new(),
             stack: Vec::new(),
             spare,
@@ -278,8 +215,9 @@ impl Shared {
 /// cell: no other memory to wait for): the one that made it in this pass, else the one
 /// whose key range holds the key of its vertex 0 (stamped before the pass). Chunk `j` owns
 /// the stamps `first + (j << shift)` and the `2^shift − 1` after it: the first marks its
-/// cells, the others its visits (in 2D, an inside and an outside mark per point), so that
-/// a visited cell stays its own.
+/// cells, the others its visits (an outside mark and, in 2D, an inside mark; in 3D one
+/// inside mark per region cell, its place in the region), so that a visited cell stays its
+/// own and no table of visited cells is needed.
 #[derive(Clone, Copy, Debug)]
 struct Ownership {
     /// The stamp of chunk 0 (values that no other visit takes, from
@@ -289,10 +227,14 @@ struct Ownership {
 }
 
 impl Ownership {
-    /// The shift that leaves room for a visit per point in chunks of `len` points, `count`
+    /// The shift that leaves room for `per` marks a point in chunks of `len` points, `count`
     /// of them (capped: a chunk out of marks defers its other points).
-    fn shift_for(count: usize, len: usize) -> u32 {
-        let shift = (2 * len + 1).next_power_of_two().trailing_zeros();
+    fn shift_for(count: usize, len: usize, per: usize) -> u32 {
+        let shift = len
+            .saturating_mul(per)
+            .saturating_add(1)
+            .checked_next_power_of_two()
+            .map_or(usize::BITS, |x| x.trailing_zeros());
         shift.min(30 - count.next_power_of_two().trailing_zeros())
     }
 
@@ -308,11 +250,10 @@ impl Ownership {
         self.first + (j << self.shift)
     }
 
-    /// The inside and outside marks of chunk `j`'s visit `k`, if it has that many.
+    /// Chunk `j`'s visit mark `k` (from 1), if it has that many.
     #[inline(always)]
-    fn visit(self, j: u32, k: u32) -> Option<(u32, u32)> {
-        let s = self.stamp(j) + 2 * k;
-        (2 * k + 2 < 1 << self.shift).then_some((s + 1, s + 2))
+    fn mark(self, j: u32, k: u32) -> Option<u32> {
+        (k < 1 << self.shift).then(|| self.stamp(j) + k)
     }
 }
 
@@ -619,7 +560,10 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         let dead = Cell::new([VertexId::NONE; N], [self.space.identity(); N]);
         self.tds.cells.resize(slots, dead);
         // every live cell stamped with its owner: the chunk whose keys hold its vertex 0's
-        let shift = Ownership::shift_for(count, n.div_ceil(count));
+        // marks a point: 2D an inside and an outside one; 3D an outside one and one a
+        // region cell (some 20 on average), with room to spare
+        let marks = if N == 3 { 2 } else { MARKS_3D };
+        let shift = Ownership::shift_for(count, n.div_ceil(count), marks);
         let own = Ownership {
             first: self.tds.reserve_stamps((count as u32) << shift),
             shift,
@@ -738,11 +682,14 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             ch.found = Found::Hidden;
             return;
         }
+        // SAFETY: the pass's cells; the chunk writes only the stamps of cells it owns.
         let found = if N == 3 {
-            // SAFETY: the pass's cells; the chunk writes only the stamps of cells it owns.
             unsafe { self.probe_around(p, (c0, q0), ch, own, (cells, vcell)) }
         } else {
-            self.probe_breadth(p, (c0, q0), ch, own)
+            let found = unsafe { self.probe_breadth(p, (c0, q0), ch, own, cells) };
+            // (the marks of this visit, whatever became of it)
+            ch.marks += 2 + ch.conflict.len() as u32;
+            found
         };
         if found {
             ch.found = if self.hides() && self.hides_vertices(&ch.conflict, &ch.boundary) {
@@ -769,11 +716,12 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         own: &Ownership,
         (cells, vcell): (&SharedCells<S::Elem, N>, &[AtomicU32]),
     ) -> bool {
-        let Some((inside, outside)) = own.visit(ch.id, ch.visits) else {
+        let marks = (own.mark(ch.id, ch.marks + 1), own.mark(ch.id, ch.marks + 2));
+        let (Some(inside), Some(outside)) = marks else {
             ch.full = true;
             return false;
         };
-        ch.visits += 1;
+        ch.marks += 2;
         ch.conflict.clear();
         ch.boundary.clear();
         ch.across.clear();
@@ -818,48 +766,63 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
 
     /// The conflict region of `p` from cell `c0` (holding it lifted by `q0`) by
     /// breadth-first search, with the links between its cells; false when the search meets
-    /// a cell the chunk does not own.
-    fn probe_breadth(
+    /// a cell the chunk does not own, or the chunk has no marks left. The visit's marks
+    /// follow the chunk's `marks`: the outside mark, then region cell `k`'s (read back, it
+    /// gives the links).
+    ///
+    /// # Safety
+    /// `cells` is the pass's store, in which no other chunk writes the cells this one owns.
+    unsafe fn probe_breadth(
         &self,
         p: S::Point,
         (c0, q0): (CellId, S::Elem),
         ch: &mut Chunk<S::Elem, N>,
         own: &Ownership,
+        cells: &SharedCells<S::Elem, N>,
     ) -> bool {
-        let owned = |c: CellId| self.owner_of(own, c) == ch.id;
-        ch.marks.clear();
         ch.conflict.clear();
         ch.links.clear();
         ch.boundary.clear();
         ch.across.clear();
+        let (Some(outside), Some(inside)) =
+            (own.mark(ch.id, ch.marks + 1), own.mark(ch.id, ch.marks + 2))
+        else {
+            ch.full = true;
+            return false;
+        };
         ch.conflict.push((c0, q0));
         ch.links.push([OUTSIDE; N]);
-        ch.marks.insert(c0, 0);
+        (*cells.get(c0)).set_stamp(inside);
         let mut next = 0;
         while next < ch.conflict.len() {
             let (c, qo) = ch.conflict[next];
             for i in 0..N {
                 let d = self.tds.cells[c.index()].n[i];
-                match ch.marks.get(d) {
-                    Some(OUTSIDE) => {}
-                    Some(k) => {
+                let st = self.tds.cells[d.index()].stamp();
+                if st != outside {
+                    // (marks of this visit, given so far, are below `inside + len`)
+                    let k = st.wrapping_sub(inside);
+                    if (k as usize) < ch.conflict.len() {
                         ch.links[next][i] = k;
                         continue;
                     }
-                    None => {
-                        if !owned(d) {
-                            return false;
-                        }
-                        if let Some(qd) = self.conflict_across((c, i, d), (p, qo), 0.0) {
-                            let k = ch.conflict.len() as u32;
-                            ch.marks.insert(d, k);
-                            ch.conflict.push((d, qd));
-                            ch.links.push([OUTSIDE; N]);
-                            ch.links[next][i] = k;
-                            continue;
-                        }
-                        ch.marks.insert(d, OUTSIDE);
+                    if own.owner(st) != ch.id {
+                        return false;
                     }
+                    if let Some(qd) = self.conflict_across((c, i, d), (p, qo), 0.0) {
+                        let k = ch.conflict.len() as u32;
+                        let Some(mark) = own.mark(ch.id, ch.marks + 2 + k) else {
+                            ch.full = true;
+                            return false;
+                        };
+                        (*cells.get(d)).set_stamp(mark);
+                        self.tds.prefetch_neighbours(d);
+                        ch.conflict.push((d, qd));
+                        ch.links.push([OUTSIDE; N]);
+                        ch.links[next][i] = k;
+                        continue;
+                    }
+                    (*cells.get(d)).set_stamp(outside);
                 }
                 let j = self.mirror_of(d, c);
                 ch.boundary.push((next as u32, i as u8));
@@ -1048,25 +1011,29 @@ mod tests {
 
     #[test]
     fn each_chunk_owns_its_cell_stamp_and_visit_marks_and_nothing_else() {
-        let shift = Ownership::shift_for(8, 100);
+        let shift = Ownership::shift_for(8, 100, 2);
         assert_eq!(shift, 8, "201 stamps a chunk round up to 256");
+        assert_eq!(
+            Ownership::shift_for(8, 100, 64),
+            13,
+            "6401 round up to 8192"
+        );
         let own = Ownership { first: 1000, shift };
         for j in 0..8 {
             assert_eq!(own.owner(own.stamp(j)), j);
-            for k in 0..100 {
-                let (inside, outside) = own.visit(j, k).expect("a visit per point");
-                assert_eq!((own.owner(inside), own.owner(outside)), (j, j));
-                assert!(inside != outside && inside != own.stamp(j));
+            let marks: Vec<u32> = (1..).map_while(|k| own.mark(j, k)).collect();
+            // every mark but the cells' stamp, all distinct and the chunk's own
+            assert_eq!(marks.len(), (1 << shift) - 1);
+            for (k, &m) in marks.iter().enumerate() {
+                assert_eq!(own.owner(m), j);
+                assert_eq!(m, own.stamp(j) + 1 + k as u32);
             }
-            // the marks run out within the chunk's range
-            let last = (0..).find(|&k| own.visit(j, k).is_none()).unwrap();
-            assert_eq!(own.owner(own.visit(j, last - 1).unwrap().1), j);
         }
         // older stamps (visits before the pass) and stamps after the last chunk: no owner
         for s in [0, 1, 999, 1000 + (8 << shift), u32::MAX] {
             assert!(own.owner(s) >= 8, "stamp {s}");
         }
         // huge chunks: capped so that the 8 chunks' stamps fit
-        assert!(8u64 << Ownership::shift_for(8, usize::MAX / 4) <= 1 << 30);
+        assert!(8u64 << Ownership::shift_for(8, usize::MAX / 4, 64) <= 1 << 30);
     }
 }
