@@ -108,6 +108,33 @@ fn a_cocircular_grid_and_a_batch_are_the_same_for_every_thread_count() {
 }
 
 #[test]
+fn a_cospherical_cube_grid_is_the_same_for_every_thread_count_and_equals_the_sequential_one() {
+    // every cube of the grid is cospherical (the perturbation decides), and the regions of
+    // the points inserted into it are large: the 3D chunks' visit marks, one a region cell
+    let k = 16;
+    let grid: Vec<[f64; 3]> = (0..k * k * k)
+        .map(|i| [i % k, (i / k) % k, i / (k * k)].map(|x| x as f64 / k as f64))
+        .collect();
+    let torus = FlatTorus3::cuboid([1.0; 3]).unwrap();
+    same_for_every_thread_count(|threads| {
+        let tri =
+            PeriodicDelaunay3::build_with(torus.clone(), &grid, with_threads(threads), go).unwrap();
+        tri.cells(Copies::Stored)
+    });
+    let bulk =
+        PeriodicDelaunay3::build_with(torus.clone(), &grid, with_threads(Some(2)), go).unwrap();
+    assert!(bulk.is_valid().is_ok());
+    let mut one_by_one = PeriodicDelaunay3::new(torus);
+    for p in &grid {
+        assert!(matches!(one_by_one.insert(*p).unwrap(), Inserted::New(_)));
+    }
+    assert_eq!(
+        common::canonical_cells(&bulk.cells(Copies::Unique)),
+        common::canonical_cells(&one_by_one.cells(Copies::Unique))
+    );
+}
+
+#[test]
 fn sphere_and_projective_plane_builds_are_the_same_for_every_thread_count() {
     let mut r = orbitri::sort::SplitMix::new(11);
     let mut pts: Vec<[f64; 3]> = (0..30_000).map(|_| r.on_sphere()).collect();
