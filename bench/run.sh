@@ -10,6 +10,12 @@
 #        CLUSTERED=0 bench/run.sh ...       skip the clustered set
 #        CLUSTER_REPS=3 (default)            repetitions of the clustered set: CGAL needs its
 #                                            27-sheeted cover there and takes ~75 s per run
+#        CUBE_CGAL=dt3 SQUARE_CGAL=dt2 ...  the CGAL commands to compare with (default: the
+#                                            periodic classes, stock and fixed, and the
+#                                            non-periodic one); the per-point cost from 10⁴
+#                                            to 10⁷: CUBE_CGAL=dt3 SQUARE_CGAL=dt2
+#                                            CLUSTERED=0 bench/run.sh 3 10000 100000
+#                                            1000000 10000000
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 anchor_src=${ANCHOR:-$root/../shared/anchors/cgal}
@@ -30,8 +36,8 @@ load() { cut -d' ' -f1 /proc/loadavg; }
 
 # input name, dimension, box, CGAL commands
 cases=()
-[ "${CUBE:-1}" = 1 ] && cases+=("cube 3 1,1,1 p3dt3,p3dt3f,dt3")
-[ "${SQUARE:-1}" = 1 ] && cases+=("square 2 1,1 p2dt2,p2dt2f,dt2")
+[ "${CUBE:-1}" = 1 ] && cases+=("cube 3 1,1,1 ${CUBE_CGAL:-p3dt3,p3dt3f,dt3}")
+[ "${SQUARE:-1}" = 1 ] && cases+=("square 2 1,1 ${SQUARE_CGAL:-p2dt2,p2dt2f,dt2}")
 for case in "${cases[@]}"; do
     read -r input dim box cmds <<<"$case"
     for n in $ns; do
