@@ -183,6 +183,14 @@ impl<O, const N: usize> Chunk<O, N> {
         }
     }
 
+    /// The chunk's next visit mark, taken; `None` when it has none left.
+    #[inline(always)]
+    fn take_mark(&mut self, own: &Ownership) -> Option<u32> {
+        let mark = own.mark(self.id, self.marks + 1)?;
+        self.marks += 1;
+        Some(mark)
+    }
+
     /// The chunk's cell slots that no cell took.
     fn leftover(&mut self) -> impl Iterator<Item = CellId> {
         let fresh = std::mem::replace(&mut self.fresh, 0..0);
@@ -686,10 +694,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         let found = if N == 3 {
             unsafe { self.probe_around(p, (c0, q0), ch, own, (cells, vcell)) }
         } else {
-            let found = unsafe { self.probe_breadth(p, (c0, q0), ch, own, cells) };
-            // (the marks of this visit, whatever became of it)
-            ch.marks += 2 + ch.conflict.len() as u32;
-            found
+            unsafe { self.probe_breadth(p, (c0, q0), ch, own, cells) }
         };
         if found {
             ch.found = if self.hides() && self.hides_vertices(&ch.conflict, &ch.boundary) {
@@ -716,12 +721,10 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         own: &Ownership,
         (cells, vcell): (&SharedCells<S::Elem, N>, &[AtomicU32]),
     ) -> bool {
-        let marks = (own.mark(ch.id, ch.marks + 1), own.mark(ch.id, ch.marks + 2));
-        let (Some(inside), Some(outside)) = marks else {
+        let (Some(inside), Some(outside)) = (ch.take_mark(own), ch.take_mark(own)) else {
             ch.full = true;
             return false;
         };
-        ch.marks += 2;
         ch.conflict.clear();
         ch.boundary.clear();
         ch.across.clear();
@@ -784,9 +787,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         ch.links.clear();
         ch.boundary.clear();
         ch.across.clear();
-        let (Some(outside), Some(inside)) =
-            (own.mark(ch.id, ch.marks + 1), own.mark(ch.id, ch.marks + 2))
-        else {
+        let (Some(outside), Some(inside)) = (ch.take_mark(own), ch.take_mark(own)) else {
             ch.full = true;
             return false;
         };
@@ -811,7 +812,8 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                     }
                     if let Some(qd) = self.conflict_across((c, i, d), (p, qo), 0.0) {
                         let k = ch.conflict.len() as u32;
-                        let Some(mark) = own.mark(ch.id, ch.marks + 2 + k) else {
+                        // (marks are taken in turn: region cell `k`'s is `inside + k`)
+                        let Some(mark) = ch.take_mark(own) else {
                             ch.full = true;
                             return false;
                         };

@@ -417,7 +417,7 @@ pub fn write_delaunay_vtu<const D: usize, const N: usize, S: FlatSpace<D, N>>(
     let mut v = Vtu::default();
     let mut index: HashMap<(InputId, S::Elem), i64> = HashMap::new();
     let mut pid = Vec::new();
-    for c in super::write::cells_of(tri)? {
+    for c in super::write::cells_of(tri)?.1 {
         for k in 0..N {
             let key = (c.vertices[k], c.offsets[k]);
             let id = *index.entry(key).or_insert_with(|| {

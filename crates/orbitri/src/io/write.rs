@@ -17,8 +17,7 @@ pub fn write_cells<const D: usize, const N: usize, S: SpaceFormat<D, N>>(
     w: &mut impl Write,
     tri: &Triangulation<D, N, S>,
 ) -> std::io::Result<()> {
-    let cells = cells_of(tri)?;
-    let count = tri.number_of_cells();
+    let (count, cells) = cells_of(tri)?;
     writeln!(w, "{} {} {}", tri.sheets(), tri.number_of_vertices(), count)?;
     // integers through `itoa` into one reused line buffer: `write!` formatting took longer
     // than the triangulation itself
@@ -50,16 +49,22 @@ pub(super) fn complex_of<const D: usize, const N: usize, S: FlatSpace<D, N>>(
         .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e.to_string()))
 }
 
-/// The cells of [`Triangulation::complex`], in its order, without its neighbour tables:
-/// read one at a time from the stored cells once the triangulation is 1-sheeted (a copy
-/// of the complex of 10⁶ points in a cube would take ~0.9 GB), else from the complex.
+/// The cells of the space.
+type Cells<'a, const D: usize, const N: usize, E> =
+    Box<dyn Iterator<Item = CellView<D, N, E>> + 'a>;
+
+/// How many cells [`Triangulation::complex`] has, and its cells in its order without its
+/// neighbour tables: read one at a time from the stored cells once the triangulation is
+/// 1-sheeted (a copy of the complex of 10⁶ points in a cube would take ~0.9 GB), else from
+/// the complex.
 pub(super) fn cells_of<'a, const D: usize, const N: usize, S: FlatSpace<D, N>>(
     tri: &'a Triangulation<D, N, S>,
-) -> std::io::Result<Box<dyn Iterator<Item = CellView<D, N, S::Elem>> + 'a>> {
+) -> std::io::Result<(usize, Cells<'a, D, N, S::Elem>)> {
     Ok(if tri.is_one_sheeted() {
-        Box::new(tri.stored_cells())
+        (tri.number_of_cells(), Box::new(tri.stored_cells()))
     } else {
-        Box::new(complex_of(tri)?.cells.into_iter())
+        let cells = complex_of(tri)?.cells;
+        (cells.len(), Box::new(cells.into_iter()))
     })
 }
 
