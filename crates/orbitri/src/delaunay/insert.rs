@@ -356,10 +356,9 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         slot_in(&self.tds.cells[c.index()].v, y, i)
     }
 
-    /// The new cells, each linked around its ridges by rotating through the conflict
-    /// region (any dimension, the boundary in any order).
+    /// The new cells, one per boundary facet (any dimension, the boundary in any order),
+    /// linked to each other by their ridges (3D) or by rotating through the conflict region.
     fn star_rotating(&mut self, scratch: &mut Scratch<S::Elem>, x: VertexId) {
-        let inside = self.tds.stamp(scratch.conflict[0].0);
         // 1. one new cell per boundary facet, linked to the outside neighbour; the conflict
         //    cell's pointer through that facet is redirected to the new cell.
         for &facet in &scratch.boundary {
@@ -371,7 +370,46 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             self.tds.cells[c.index()].n[i] = nc;
             scratch.created.push(nc);
         }
-        // 2. link the new cells around each ridge by rotating through the conflict region.
+        // 2. link the new cells to each other
+        if N == 4 && self.link_by_ridges(scratch, x) {
+            return;
+        }
+        self.link_by_rotation(scratch);
+    }
+
+    /// 3D: links the new cells across their facets through `x`, pairing them by the
+    /// boundary edge each facet stands on ([`Ridges`](super::ridges::Ridges)). False,
+    /// linking nothing, when the star is not simplicial.
+    fn link_by_ridges(&mut self, scratch: &Scratch<S::Elem>, x: VertexId) -> bool {
+        let mut ridges = std::mem::take(&mut self.ridges);
+        let cells = scratch
+            .created
+            .iter()
+            .zip(&scratch.boundary)
+            .map(|(&nc, &(_, i))| {
+                (
+                    nc.0,
+                    self.tds.cells[nc.index()].v,
+                    self.slot(nc, x, i as usize),
+                )
+            });
+        let linked = match ridges.pair(cells) {
+            Some(pairs) => {
+                for &(c, k, d, l) in pairs {
+                    self.link(CellId(c), k as usize, CellId(d), l as usize);
+                }
+                true
+            }
+            None => false,
+        };
+        self.ridges = ridges;
+        linked
+    }
+
+    /// Links the new cells around each ridge by rotating through the conflict region (its
+    /// cells' pointers through the boundary facets already redirected to the new cells).
+    fn link_by_rotation(&mut self, scratch: &Scratch<S::Elem>) {
+        let inside = self.tds.stamp(scratch.conflict[0].0);
         for (k, &(ci, i)) in scratch.boundary.iter().enumerate() {
             let nc = scratch.created[k];
             let c0 = scratch.conflict[ci as usize].0;

@@ -11,6 +11,7 @@ mod insert;
 mod locator;
 mod parallel;
 mod remove;
+mod ridges;
 mod validate;
 mod wrap;
 
@@ -145,6 +146,8 @@ pub struct Engine<S: OrbitSpace<N>, const N: usize> {
     rng: SplitMix,
     scratch: Scratch<S::Elem>,
     around: Around,
+    /// 3D: the star's boundary edges, to pair its new cells.
+    ridges: ridges::Ridges,
     /// Jump-and-walk grid of the 1-sheeted triangulation.
     locator: locator::Locator,
     /// Threads of the parallel bulk insertion (0: one by one).
@@ -178,6 +181,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             rng: SplitMix::new(0x5eed),
             scratch: Scratch::default(),
             around: Around::default(),
+            ridges: ridges::Ridges::default(),
             locator: locator::Locator::default(),
             threads: 0,
         };

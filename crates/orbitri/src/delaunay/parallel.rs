@@ -33,6 +33,7 @@ use std::sync::atomic::{AtomicU32, AtomicUsize};
 use rayon::prelude::*;
 
 use super::insert::{closes, edge_ends, enter, next_edge, slot_in, Frame, Refused};
+use super::ridges::Ridges;
 use super::{Engine, HiddenPoint, Inserted};
 use crate::ids::{CellId, PointId, VertexId};
 use crate::sort::SplitMix;
@@ -154,6 +155,8 @@ struct Chunk<O, const N: usize> {
     ids: Vec<CellId>,
     on_facet: Vec<[u32; N]>,
     orphans: Vec<VertexId>,
+    /// 3D: the boundary edges of its region, to pair the new cells.
+    ridges: Ridges,
 }
 
 impl<O, const N: usize> Chunk<O, N> {
@@ -180,6 +183,7 @@ impl<O, const N: usize> Chunk<O, N> {
             ids: Vec::new(),
             on_facet: Vec::new(),
             orphans: Vec::new(),
+            ridges: Ridges::default(),
         }
     }
 
@@ -838,9 +842,9 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
 
 /// Stars a chunk's region from its new vertex `x`: the new cells take the region's slots
 /// (those left over become the chunk's spares), then spares and fresh slots of the chunk,
-/// and are stamped its own; they are linked to the cells across the boundary and, around
-/// each new ridge, to each other by rotating through the region (read from local copies,
-/// since the slots are overwritten). Vertices whose cell was in the region point at a new
+/// and are stamped its own; they are linked to the cells across the boundary and to each
+/// other (2D as a fan, 3D by their boundary edges, or else by rotating through the region,
+/// read from local copies, since the slots are overwritten). Vertices whose cell was in the region point at a new
 /// cell. False, changing nothing, when the chunk has too few slots left.
 ///
 /// # Safety
@@ -910,6 +914,16 @@ unsafe fn commit<S: OrbitSpace<N>, const N: usize>(
             let sb = slot_in(&new[next].v, ch.rim[next].1, ch.boundary[next].1 as usize);
             new[k].n[sa] = ids[next];
             new[next].n[sb] = ids[k];
+        }
+    } else if let Some(pairs) = ch.ridges.pair(
+        new.iter()
+            .enumerate()
+            .map(|(k, c)| (k as u32, c.v, c.index_of(x).expect("the new vertex"))),
+    ) {
+        // 3D: paired by the boundary edges (as [`Engine::link_by_ridges`] links them)
+        for &(a, i, b, j) in pairs {
+            new[a as usize].n[i as usize] = ids[b as usize];
+            new[b as usize].n[j as usize] = ids[a as usize];
         }
     } else {
         link_by_rotation(
