@@ -844,8 +844,9 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
 /// (those left over become the chunk's spares), then spares and fresh slots of the chunk,
 /// and are stamped its own; they are linked to the cells across the boundary and to each
 /// other (2D as a fan, 3D by their boundary edges, or else by rotating through the region,
-/// read from local copies, since the slots are overwritten). Vertices whose cell was in the region point at a new
-/// cell. False, changing nothing, when the chunk has too few slots left.
+/// read from local copies, since the slots are overwritten). Vertices whose cell was in the
+/// region point at a new cell. False, changing nothing, when the chunk has too few slots
+/// left.
 ///
 /// # Safety
 /// The chunk owns its region and the cells across it, and its slots; no other thread

@@ -13,7 +13,8 @@ use std::hint::select_unpredictable;
 use crate::ids::VertexId;
 
 /// One edge seen so far: its ends (the smaller id in the high half; 0 marks an empty
-/// entry, since the ends differ), the new cell's tag and its slot opposite the facet on the edge.
+/// entry, since the ends differ), the new cell's tag and its slot opposite the facet on
+/// the edge.
 #[derive(Clone, Copy, Debug, Default)]
 struct Entry {
     key: u64,
@@ -56,11 +57,11 @@ impl Ridges {
         self.broken = false;
     }
 
-    /// Notes that the new cell tagged `tag` stands on the boundary edge `(a, b)` with the facet
-    /// opposite its `slot`: the second cell on an edge makes a pair with the first. Written
-    /// without a branch on the outcome: whether an edge is met for the first or the second
-    /// time is as good as random, and a mispredicted branch each time cost more than the
-    /// rest of the work.
+    /// Notes that the new cell tagged `tag` stands on the boundary edge `(a, b)` with the
+    /// facet opposite its `slot`: the second cell on an edge makes a pair with the first.
+    /// Written without a branch on the outcome: whether an edge is met for the first or the
+    /// second time is as good as random, and a mispredicted branch each time cost more than
+    /// the rest of the work.
     #[inline(always)]
     fn meet(&mut self, (a, b): (VertexId, VertexId), tag: u32, slot: usize) {
         let key = (u64::from(a.0.min(b.0)) << 32) | u64::from(a.0.max(b.0));
@@ -152,11 +153,16 @@ mod tests {
             .collect()
     }
 
-    /// Every facet through the new vertex is paired once, with the cell across it.
-    fn check(cells: &[(u32, [VertexId; 4], usize)], pairs: &[(u32, u8, u32, u8)]) {
+    /// Pairs the cells of a simplicial star and checks that every facet through the new
+    /// vertex is paired once, with the cell across it.
+    fn pair_and_check(r: &mut Ridges, cells: &[(u32, [VertexId; 4], usize)]) {
+        let pairs = r
+            .pair(cells.iter().copied())
+            .expect("a simplicial star")
+            .to_vec();
         assert_eq!(2 * pairs.len(), 3 * cells.len());
         let mut seen = std::collections::HashSet::new();
-        for &(a, i, b, j) in pairs {
+        for (a, i, b, j) in pairs {
             let facet = |c: u32, s: u8| {
                 let mut f: Vec<_> = (0..4)
                     .filter(|&k| k != s as usize)
@@ -178,11 +184,7 @@ mod tests {
         // the hole is a tetrahedron: four cells, six pairs; the new vertex in any slot
         for x in 0..4 {
             let cells = cone(&[[2, 3, 4], [1, 3, 4], [1, 2, 4], [1, 2, 3]], x);
-            let pairs = r
-                .pair(cells.iter().copied())
-                .expect("a simplicial star")
-                .to_vec();
-            check(&cells, &pairs);
+            pair_and_check(&mut r, &cells);
         }
         // a bipyramid over a 1000-gon: 2000 cells, a table grown past its first size,
         // collisions, and the entries of the stars before emptied
@@ -195,11 +197,7 @@ mod tests {
             .collect();
         for x in [1, 3] {
             let cells = cone(&faces, x);
-            let pairs = r
-                .pair(cells.iter().copied())
-                .expect("a simplicial star")
-                .to_vec();
-            check(&cells, &pairs);
+            pair_and_check(&mut r, &cells);
         }
     }
 
@@ -219,11 +217,7 @@ mod tests {
         assert_eq!(r.pair([(0, [VertexId(0); 3], 0)].into_iter()), None);
         // and the table is clean for the next star
         let cells = cone(&[[2, 3, 4], [1, 3, 4], [1, 2, 4], [1, 2, 3]], 2);
-        let pairs = r
-            .pair(cells.iter().copied())
-            .expect("a simplicial star")
-            .to_vec();
-        check(&cells, &pairs);
+        pair_and_check(&mut r, &cells);
     }
 
     #[test]
