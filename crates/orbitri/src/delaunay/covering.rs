@@ -310,7 +310,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.hint = CellId::NONE;
         self.copy_hints.clear();
         if self.one_sheeted {
-            self.refill_locator();
+            self.renumber_locator(&map);
         }
         map
     }
