@@ -9,7 +9,8 @@
 //! sequential insertion would (each walk starts from its last insertion, or every 64th from
 //! a cell located before the pass), but only where it owns everything it reads or writes:
 //! the walk, the conflict region and the cells across its boundary. A point that needs
-//! another chunk's cell is deferred. The chunks run on
+//! another chunk's cell, or whose 3D star the ridge table refuses, is deferred. The chunks
+//! run on
 //! the threads in any order and at once, with no lock: a cell next to a chunk's own cell
 //! cannot change while it is, since changing it would write the chunk's cell.
 //!
@@ -49,8 +50,6 @@ const CHUNKS: usize = 8;
 /// Cell slots reserved for a chunk beyond its points' share.
 const MARGIN: usize = 64;
 
-/// Visit marks a point in 3D ([`Ownership`]): an outside one and one a region cell.
-const MARKS_3D: usize = 64;
 /// Every this many points of a chunk, one is located before the pass, to walk from (the
 /// others walk from the chunk's last insertion): walks that keep failing, from cells of the
 /// chunk cut off by others', start afresh there.
@@ -110,9 +109,6 @@ enum Outcome {
     Alone,
 }
 
-/// The link of a region cell's facet to no region cell (see [`Chunk::links`]).
-const OUTSIDE: u32 = u32::MAX;
-
 /// A chunk of a pass: its points (`range`, positions in the wave), the cell slots it may
 /// fill, its last insertion, and what the probe found for its current point.
 #[derive(Debug)]
@@ -134,8 +130,6 @@ struct Chunk<O, const N: usize> {
     boundary: Vec<(u32, u8)>,
     /// Per boundary facet: the cell across and the facet's index there.
     across: Vec<(CellId, u8)>,
-    /// Per region cell and facet: the index of the region cell across, or `OUTSIDE`.
-    links: Vec<[u32; N]>,
     /// The visit marks taken so far from the chunk's stamps ([`Ownership::mark`]).
     marks: u32,
     /// 2D: the boundary edges' ends in the order of a walk around the region with the
@@ -149,11 +143,10 @@ struct Chunk<O, const N: usize> {
     /// What became of its points: (position in the wave, outcome), deferred ones omitted.
     outcomes: Vec<(u32, Outcome)>,
     /// Buffers of `commit`: the region's cells as they were, the new cells, their slots,
-    /// per region cell and facet the new cell on it, and the vertices whose cell dies.
+    /// and the vertices whose cell dies.
     old: Vec<Cell<O, N>>,
     new: Vec<Cell<O, N>>,
     ids: Vec<CellId>,
-    on_facet: Vec<[u32; N]>,
     orphans: Vec<VertexId>,
     /// 3D: the boundary edges of its region, to pair the new cells.
     ridges: Ridges,
@@ -171,7 +164,6 @@ impl<O, const N: usize> Chunk<O, N> {
             conflict: Vec::new(),
             boundary: Vec::new(),
             across: Vec::new(),
-            links: Vec::new(),
             marks: 0,
             rim: Vec::new(),
             stack: Vec::new(),
@@ -181,7 +173,6 @@ impl<O, const N: usize> Chunk<O, N> {
             old: Vec::new(),
             new: Vec::new(),
             ids: Vec::new(),
-            on_facet: Vec::new(),
             orphans: Vec::new(),
             ridges: Ridges::default(),
         }
@@ -227,9 +218,8 @@ impl Shared {
 /// cell: no other memory to wait for): the one that made it in this pass, else the one
 /// whose key range holds the key of its vertex 0 (stamped before the pass). Chunk `j` owns
 /// the stamps `first + (j << shift)` and the `2^shift − 1` after it: the first marks its
-/// cells, the others its visits (an outside mark and, in 2D, an inside mark; in 3D one
-/// inside mark per region cell, its place in the region), so that a visited cell stays its
-/// own and no table of visited cells is needed.
+/// cells, the others its visits (an inside and an outside mark a point), so that a visited
+/// cell stays its own and no table of visited cells is needed.
 #[derive(Clone, Copy, Debug)]
 struct Ownership {
     /// The stamp of chunk 0 (values that no other visit takes, from
@@ -344,11 +334,13 @@ impl<S: OrbitSpace<N>, const N: usize> Pass<'_, S, N> {
                 Found::Region => {
                     let x = VertexId::new(self.base + s);
                     let e = self.engine;
-                    if commit(&e.space, e.level, &self.cells, self.vcell, stamp, ch, x) {
-                        Outcome::New
-                    } else {
-                        ch.full = true;
-                        continue;
+                    match commit(&e.space, e.level, &self.cells, self.vcell, stamp, ch, x) {
+                        Commit::Starred => Outcome::New,
+                        Commit::OutOfSlots => {
+                            ch.full = true;
+                            continue;
+                        }
+                        Commit::NotSimplicial => continue,
                     }
                 }
                 Found::Duplicate(p) => Outcome::Duplicate(p),
@@ -572,10 +564,8 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         let dead = Cell::new([VertexId::NONE; N], [self.space.identity(); N]);
         self.tds.cells.resize(slots, dead);
         // every live cell stamped with its owner: the chunk whose keys hold its vertex 0's
-        // marks a point: 2D an inside and an outside one; 3D an outside one and one a
-        // region cell (some 20 on average), with room to spare
-        let marks = if N == 3 { 2 } else { MARKS_3D };
-        let shift = Ownership::shift_for(count, n.div_ceil(count), marks);
+        // (a point takes two marks: an inside and an outside one)
+        let shift = Ownership::shift_for(count, n.div_ceil(count), 2);
         let own = Ownership {
             first: self.tds.reserve_stamps((count as u32) << shift),
             shift,
@@ -771,11 +761,10 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         closes(&ch.rim, ch.boundary.len())
     }
 
-    /// The conflict region of `p` from cell `c0` (holding it lifted by `q0`) by
-    /// breadth-first search, with the links between its cells; false when the search meets
-    /// a cell the chunk does not own, or the chunk has no marks left. The visit's marks
-    /// follow the chunk's `marks`: the outside mark, then region cell `k`'s (read back, it
-    /// gives the links).
+    /// 3D: the conflict region of `p` from cell `c0` (holding it lifted by `q0`) by
+    /// breadth-first search, as [`Engine::conflict_region`] finds it, the visit's inside
+    /// and outside marks stamps of the chunk (a visited cell stays its own). False when the
+    /// search meets a cell the chunk does not own, or the chunk has no marks left.
     ///
     /// # Safety
     /// `cells` is the pass's store, in which no other chunk writes the cells this one owns.
@@ -788,15 +777,13 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         cells: &SharedCells<S::Elem, N>,
     ) -> bool {
         ch.conflict.clear();
-        ch.links.clear();
         ch.boundary.clear();
         ch.across.clear();
-        let (Some(outside), Some(inside)) = (ch.take_mark(own), ch.take_mark(own)) else {
+        let (Some(inside), Some(outside)) = (ch.take_mark(own), ch.take_mark(own)) else {
             ch.full = true;
             return false;
         };
         ch.conflict.push((c0, q0));
-        ch.links.push([OUTSIDE; N]);
         (*cells.get(c0)).set_stamp(inside);
         let mut next = 0;
         while next < ch.conflict.len() {
@@ -804,28 +791,17 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             for i in 0..N {
                 let d = self.tds.cells[c.index()].n[i];
                 let st = self.tds.cells[d.index()].stamp();
+                if st == inside {
+                    continue;
+                }
                 if st != outside {
-                    // (marks of this visit, given so far, are below `inside + len`)
-                    let k = st.wrapping_sub(inside);
-                    if (k as usize) < ch.conflict.len() {
-                        ch.links[next][i] = k;
-                        continue;
-                    }
                     if own.owner(st) != ch.id {
                         return false;
                     }
                     if let Some(qd) = self.conflict_across((c, i, d), (p, qo), 0.0) {
-                        let k = ch.conflict.len() as u32;
-                        // (marks are taken in turn: region cell `k`'s is `inside + k`)
-                        let Some(mark) = ch.take_mark(own) else {
-                            ch.full = true;
-                            return false;
-                        };
-                        (*cells.get(d)).set_stamp(mark);
+                        (*cells.get(d)).set_stamp(inside);
                         self.tds.prefetch_neighbours(d);
                         ch.conflict.push((d, qd));
-                        ch.links.push([OUTSIDE; N]);
-                        ch.links[next][i] = k;
                         continue;
                     }
                     (*cells.get(d)).set_stamp(outside);
@@ -840,13 +816,22 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     }
 }
 
+/// What a chunk's [`commit`] did.
+enum Commit {
+    Starred,
+    /// Nothing: the chunk has too few cell slots left.
+    OutOfSlots,
+    /// Nothing: the 3D star is not simplicial (a boundary edge not under exactly two new
+    /// cells, see [`Ridges::pair`]); the sequential code, which links such stars by
+    /// rotation, inserts the point.
+    NotSimplicial,
+}
+
 /// Stars a chunk's region from its new vertex `x`: the new cells take the region's slots
 /// (those left over become the chunk's spares), then spares and fresh slots of the chunk,
 /// and are stamped its own; they are linked to the cells across the boundary and to each
-/// other (2D as a fan, 3D by their boundary edges, or else by rotating through the region,
-/// read from local copies, since the slots are overwritten). Vertices whose cell was in the
-/// region point at a new cell. False, changing nothing, when the chunk has too few slots
-/// left.
+/// other (2D as a fan, 3D by their boundary edges). Vertices whose cell was in the region
+/// point at a new cell.
 ///
 /// # Safety
 /// The chunk owns its region and the cells across it, and its slots; no other thread
@@ -860,38 +845,14 @@ unsafe fn commit<S: OrbitSpace<N>, const N: usize>(
     stamp: u32,
     ch: &mut Chunk<S::Elem, N>,
     x: VertexId,
-) -> bool {
+) -> Commit {
     let extra = ch.boundary.len().saturating_sub(ch.conflict.len());
     if ch.spare.len() + ch.fresh.len() < extra {
-        return false;
+        return Commit::OutOfSlots;
     }
-    let (old, new, ids, on_facet, orphans) = (
-        &mut ch.old,
-        &mut ch.new,
-        &mut ch.ids,
-        &mut ch.on_facet,
-        &mut ch.orphans,
-    );
+    let (old, new, ids) = (&mut ch.old, &mut ch.new, &mut ch.ids);
     old.clear();
     old.extend(ch.conflict.iter().map(|&(c, _)| *cells.get(c)));
-    // (a vertex whose cell is in the region is the chunk's to point elsewhere: no other
-    // chunk writes it meanwhile, since it points at none of their regions)
-    if N != 3 {
-        // (2D: found by the probe)
-        orphans.clear();
-        for (cell, &(c, _)) in old.iter().zip(&ch.conflict) {
-            orphans_of(vcell, c, &cell.v, orphans);
-        }
-    }
-    ids.clear();
-    ids.extend(ch.conflict.iter().map(|&(c, _)| c).take(ch.boundary.len()));
-    while ids.len() < ch.boundary.len() {
-        let id = ch.spare.pop().unwrap_or_else(|| {
-            ch.fresh.start += 1;
-            CellId::new(ch.fresh.start - 1)
-        });
-        ids.push(id);
-    }
     new.clear();
     for (k, &(ci, i)) in ch.boundary.iter().enumerate() {
         let (ci, i) = (ci as usize, i as usize);
@@ -906,6 +867,41 @@ unsafe fn commit<S: OrbitSpace<N>, const N: usize>(
         cell.n[slot] = ch.across[k].0;
         new.push(cell);
     }
+    // 3D: paired by the boundary edges (as [`Engine::link_by_ridges`] pairs them)
+    let pairs = if N == 4 {
+        let cells = new.iter().enumerate();
+        let pairs = ch
+            .ridges
+            .pair(cells.map(|(k, c)| (k as u32, c.v, c.index_of(x).expect("the new vertex"))));
+        let Some(pairs) = pairs else {
+            return Commit::NotSimplicial;
+        };
+        pairs
+    } else {
+        &[]
+    };
+    // (a vertex whose cell is in the region is the chunk's to point elsewhere: no other
+    // chunk writes it meanwhile, since it points at none of their regions)
+    if N != 3 {
+        // (2D: found by the probe)
+        ch.orphans.clear();
+        for (cell, &(c, _)) in old.iter().zip(&ch.conflict) {
+            orphans_of(vcell, c, &cell.v, &mut ch.orphans);
+        }
+    }
+    ids.clear();
+    ids.extend(ch.conflict.iter().map(|&(c, _)| c).take(ch.boundary.len()));
+    while ids.len() < ch.boundary.len() {
+        let id = ch.spare.pop().unwrap_or_else(|| {
+            ch.fresh.start += 1;
+            CellId::new(ch.fresh.start - 1)
+        });
+        ids.push(id);
+    }
+    for &(a, i, b, j) in pairs {
+        new[a as usize].n[i as usize] = ids[b as usize];
+        new[b as usize].n[j as usize] = ids[a as usize];
+    }
     if N == 3 {
         // 2D: a fan, in the order of the rim (as [`Engine::star_around`] links it)
         let m = new.len();
@@ -916,26 +912,6 @@ unsafe fn commit<S: OrbitSpace<N>, const N: usize>(
             new[k].n[sa] = ids[next];
             new[next].n[sb] = ids[k];
         }
-    } else if let Some(pairs) = ch.ridges.pair(
-        new.iter()
-            .enumerate()
-            .map(|(k, c)| (k as u32, c.v, c.index_of(x).expect("the new vertex"))),
-    ) {
-        // 3D: paired by the boundary edges (as [`Engine::link_by_ridges`] links them)
-        for &(a, i, b, j) in pairs {
-            new[a as usize].n[i as usize] = ids[b as usize];
-            new[b as usize].n[j as usize] = ids[a as usize];
-        }
-    } else {
-        link_by_rotation(
-            &ch.conflict,
-            &ch.boundary,
-            &ch.links,
-            old,
-            new,
-            ids,
-            on_facet,
-        );
     }
     for (k, cell) in new.iter().enumerate() {
         let mut cell = *cell;
@@ -944,7 +920,7 @@ unsafe fn commit<S: OrbitSpace<N>, const N: usize>(
         let (d, jd) = ch.across[k];
         (*cells.get(d)).n[jd as usize] = ids[k];
         for &v in &cell.v {
-            if v == x || orphans.contains(&v) {
+            if v == x || ch.orphans.contains(&v) {
                 vcell[v.index()].store(ids[k].0, Relaxed);
             }
         }
@@ -959,7 +935,7 @@ unsafe fn commit<S: OrbitSpace<N>, const N: usize>(
         new[0].v,
         space.carry(space.identity(), new[0].off[k]),
     ));
-    true
+    Commit::Starred
 }
 
 /// Adds to `orphans` the vertices `v` of region cell `c` whose cell it is (the commit
@@ -975,53 +951,6 @@ fn orphans_of<const N: usize>(
     orphans.extend(v.iter().filter(|&&x| vcell[x.index()].load(Relaxed) == c.0));
 }
 
-/// Links the new cells of a chunk's region around each new ridge by rotating through the
-/// region (its cells as they were in `old`, their links in the chunk), any dimension.
-fn link_by_rotation<O: Copy, const N: usize>(
-    conflict: &[(CellId, O)],
-    boundary: &[(u32, u8)],
-    links: &[[u32; N]],
-    old: &[Cell<O, N>],
-    new: &mut [Cell<O, N>],
-    ids: &[CellId],
-    on_facet: &mut Vec<[u32; N]>,
-) {
-    on_facet.clear();
-    on_facet.resize(old.len(), [u32::MAX; N]);
-    for (k, &(ci, i)) in boundary.iter().enumerate() {
-        on_facet[ci as usize][i as usize] = k as u32;
-    }
-    for k in 0..new.len() {
-        let (ci, i) = boundary[k];
-        for j in 0..N {
-            if new[k].n[j] != CellId::NONE {
-                continue;
-            }
-            let (mut u, mut w) = (old[ci as usize].v[i as usize], new[k].v[j]);
-            let mut cur = ci as usize;
-            loop {
-                let cc = &old[cur];
-                let kw = cc.index_of(w).expect("ridge rotation");
-                match links[cur][kw] {
-                    OUTSIDE => {
-                        let k2 = on_facet[cur][kw] as usize;
-                        let ku = new[k2].index_of(u).expect("ridge rotation");
-                        new[k].n[j] = ids[k2];
-                        new[k2].n[ku] = ids[k];
-                        break;
-                    }
-                    next => {
-                        let nb = &old[next as usize];
-                        let m = nb.mirror(conflict[cur].0).expect("symmetric neighbours");
-                        (w, u) = (u, nb.v[m]);
-                        cur = next as usize;
-                    }
-                }
-            }
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::Ownership;
@@ -1030,11 +959,7 @@ mod tests {
     fn each_chunk_owns_its_cell_stamp_and_visit_marks_and_nothing_else() {
         let shift = Ownership::shift_for(8, 100, 2);
         assert_eq!(shift, 8, "201 stamps a chunk round up to 256");
-        assert_eq!(
-            Ownership::shift_for(8, 100, 64),
-            13,
-            "6401 round up to 8192"
-        );
+        assert_eq!(Ownership::shift_for(8, 100, 5), 9, "501 round up to 512");
         let own = Ownership { first: 1000, shift };
         for j in 0..8 {
             assert_eq!(own.owner(own.stamp(j)), j);

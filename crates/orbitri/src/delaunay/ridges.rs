@@ -6,7 +6,8 @@
 //! ids, through a small open-addressing hash table, where rotating around each edge through
 //! the conflict cells loads cells and takes a branch the processor cannot predict at each
 //! step. A third cell on an edge means the star is not simplicial (two edges with the same
-//! ends); the table then says so and the caller rotates instead.
+//! ends); the table then says so, and the sequential code rotates instead (a parallel chunk
+//! leaves the point to it).
 
 use std::hint::select_unpredictable;
 
