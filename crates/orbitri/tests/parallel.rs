@@ -108,6 +108,35 @@ fn a_cocircular_grid_and_a_batch_are_the_same_for_every_thread_count() {
 }
 
 #[test]
+fn small_and_large_batches_are_the_same_for_every_thread_count_and_equal_one_by_one() {
+    let torus = FlatTorus3::cuboid([1.0; 3]).unwrap();
+    let pts = common::uniform(4_000, 11, [1.0; 3]);
+    let batches = |threads| {
+        let mut tri =
+            PeriodicDelaunay3::build_with(torus.clone(), &pts[..2500], with_threads(threads), go)
+                .unwrap();
+        // under a 32nd of the points: one at a time even with threads; then waves
+        let small = tri.insert_all(&pts[2500..2560]).unwrap();
+        let large = tri.insert_all(&pts[2560..]).unwrap();
+        (tri, small, large)
+    };
+    same_for_every_thread_count(|threads| {
+        let (tri, small, large) = batches(threads);
+        (tri.cells(Copies::Stored), small, large)
+    });
+    let (tri, ..) = batches(Some(2));
+    assert!(tri.is_valid().is_ok());
+    let mut one_by_one = PeriodicDelaunay3::new(torus);
+    for p in &pts {
+        one_by_one.insert(*p).unwrap();
+    }
+    assert_eq!(
+        common::canonical_cells(&tri.cells(Copies::Unique)),
+        common::canonical_cells(&one_by_one.cells(Copies::Unique))
+    );
+}
+
+#[test]
 fn a_cospherical_cube_grid_is_the_same_for_every_thread_count_and_equals_the_sequential_one() {
     // every cube of the grid is cospherical (the perturbation decides), and the regions of
     // the points inserted into it are large: the 3D chunks' visit marks, one a region cell

@@ -309,6 +309,8 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         }
         self.hint = CellId::NONE;
         self.copy_hints.clear();
+        // (renumbered: computed again by the next parallel insertion)
+        self.wave_keys = Vec::new();
         if self.one_sheeted {
             self.renumber_locator(&map);
         }

@@ -2,7 +2,7 @@
 //!
 //! The points arrive in BRIO + Hilbert order. After a short sequential start they go in
 //! waves, each of the next as many points as there are (so that a wave at most doubles the
-//! triangulation). A wave is sorted along the Hilbert curve and cut into [`CHUNKS`] chunks
+//! triangulation); fewer than a 32nd of the points go one at a time. A wave is sorted along the Hilbert curve and cut into [`CHUNKS`] chunks
 //! of consecutive points, and each chunk **owns** the cells of its stretch of the curve: a
 //! cell belongs to the chunk whose range holds the spatial key of its vertex 0, and a new
 //! cell to the chunk that made it. A chunk inserts its points one after another, as a
@@ -47,6 +47,10 @@ const SEQUENTIAL_START: usize = 2048;
 /// triangulation, must not depend on it): as many threads can be busy, and their borders
 /// defer a quarter of a wave (44 % with 16 chunks, 16 % with 4; 10⁶ points in a cube).
 const CHUNKS: usize = 8;
+/// The fewest points a wave holds, as a fraction of the triangulation's (`1/FEWEST`): a pass
+/// stamps every cell first (20 ms at 10⁶ points in a square, 30 ms in a cube), which a
+/// smaller wave (the tail of a BRIO round, a small batch) saves by going one at a time.
+const FEWEST: usize = 32;
 /// Cell slots reserved for a chunk beyond its points' share.
 const MARGIN: usize = 64;
 
@@ -195,7 +199,8 @@ impl<O, const N: usize> Chunk<O, N> {
     }
 }
 
-/// The state kept across the waves of one parallel insertion.
+/// The state kept across the waves of parallel insertions ([`Engine`]'s `wave_keys`
+/// between them).
 #[derive(Debug, Default)]
 struct Shared {
     /// Per point: its spatial key (stale for points renumbered by a hiding insertion, which
@@ -365,14 +370,16 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         (self.threads > 0).then_some(self.threads)
     }
 
-    /// True when the next insertions may run in parallel: a 1-sheeted, unweighted
-    /// triangulation whose switch criterion holds, large enough that chunks seldom meet.
-    fn parallel_ready(&self) -> bool {
+    /// True when the next `left` insertions may run in parallel: a 1-sheeted, unweighted
+    /// triangulation whose switch criterion holds, large enough that chunks seldom meet,
+    /// and enough of them for a wave ([`FEWEST`]).
+    fn wave_ready(&self, left: usize) -> bool {
         self.threads > 0
             && self.one_sheeted
             && self.guaranteed
             && !self.weighted
             && self.points.len() >= SEQUENTIAL_START
+            && left.saturating_mul(FEWEST) >= self.points.len()
     }
 
     /// Inserts `items`: one by one in their order, or once [`Self::set_threads`] asked for
@@ -391,24 +398,28 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             events: Vec::with_capacity(items.len()),
             hidden: Vec::new(),
         };
-        let mut shared = Shared::default();
+        let mut shared = Shared {
+            keys: std::mem::take(&mut self.wave_keys),
+        };
         let mut k = 0;
         while k < items.len() {
             if progress(k).is_break() {
+                self.wave_keys = shared.keys;
                 return (log, ControlFlow::Break(()));
             }
-            if self.parallel_ready() {
+            if self.wave_ready(items.len() - k) {
                 let m = (items.len() - k).min(self.points.len());
                 self.wave(items, k..k + m, &mut shared, &mut log);
                 k += m;
                 continue;
             }
             let end = (k + 4096).min(items.len());
-            while k < end && !self.parallel_ready() {
+            while k < end && !self.wave_ready(items.len() - k) {
                 self.insert_alone(items, k, &mut log);
                 k += 1;
             }
         }
+        self.wave_keys = shared.keys;
         (log, ControlFlow::Continue(()))
     }
 
@@ -953,7 +964,28 @@ fn orphans_of<const N: usize>(
 
 #[cfg(test)]
 mod tests {
-    use super::Ownership;
+    use super::{Ownership, FEWEST};
+    use crate::delaunay::Engine;
+    use crate::sort::SplitMix;
+    use crate::space::FlatTorus3;
+
+    #[test]
+    fn a_wave_needs_threads_a_guaranteed_quotient_and_a_32nd_of_the_points() {
+        let mut e = Engine::new(FlatTorus3::cuboid([1.0; 3]).unwrap());
+        let mut r = SplitMix::new(3);
+        for _ in 0..4000 {
+            e.insert([r.unit(), r.unit(), r.unit()]);
+        }
+        assert!(e.is_one_sheeted() && e.guaranteed);
+        let n = e.points.len();
+        let fewest = n.div_ceil(FEWEST);
+        assert!(!e.wave_ready(n), "no threads asked for");
+        e.set_threads(Some(2));
+        assert!(e.wave_ready(n) && e.wave_ready(fewest) && e.wave_ready(usize::MAX));
+        assert!(!e.wave_ready(fewest - 1) && !e.wave_ready(0));
+        e.set_threads(None);
+        assert!(!e.wave_ready(fewest));
+    }
 
     #[test]
     fn each_chunk_owns_its_cell_stamp_and_visit_marks_and_nothing_else() {
