@@ -152,9 +152,11 @@ pub struct Engine<S: OrbitSpace<N>, const N: usize> {
     locator: locator::Locator,
     /// Threads of the parallel bulk insertion (0: one by one).
     threads: usize,
-    /// The parallel insertion's spatial key of each point, as far as computed (kept from
-    /// one batch to the next: recomputing every key took a tenth of a second a batch at
-    /// 10⁶ points; stale keys of renumbered points only move chunk borders).
+    /// The parallel insertion's spatial key of each point, as far as computed, kept from
+    /// one call of [`Engine::insert_parallel`] (a BRIO round) to the next until the batch
+    /// ends ([`Engine::end_batch`]): computing every key at each call took a tenth of a
+    /// second a round at 10⁶ points. (Keys of points renumbered within a batch by a hiding
+    /// insertion go stale; that only moves chunk borders.)
     wave_keys: Vec<u64>,
 }
 

@@ -2,7 +2,8 @@
 //!
 //! The points arrive in BRIO + Hilbert order. After a short sequential start they go in
 //! waves, each of the next as many points as there are (so that a wave at most doubles the
-//! triangulation); fewer than a 32nd of the points go one at a time. A wave is sorted along the Hilbert curve and cut into [`CHUNKS`] chunks
+//! triangulation); when fewer than a 32nd of the points are left in the call (a BRIO
+//! round), they go one at a time. A wave is sorted along the Hilbert curve and cut into [`CHUNKS`] chunks
 //! of consecutive points, and each chunk **owns** the cells of its stretch of the curve: a
 //! cell belongs to the chunk whose range holds the spatial key of its vertex 0, and a new
 //! cell to the chunk that made it. A chunk inserts its points one after another, as a
@@ -199,8 +200,8 @@ impl<O, const N: usize> Chunk<O, N> {
     }
 }
 
-/// The state kept across the waves of parallel insertions ([`Engine`]'s `wave_keys`
-/// between them).
+/// The state kept across the waves of parallel insertions (in [`Engine`] between the calls
+/// of one batch, until [`Engine::end_batch`]).
 #[derive(Debug, Default)]
 struct Shared {
     /// Per point: its spatial key (stale for points renumbered by a hiding insertion, which
@@ -209,7 +210,7 @@ struct Shared {
 }
 
 impl Shared {
-    /// The keys of `points[..base]`: those not computed yet, or renumbered since.
+    /// The keys of `points[..base]`: those not computed yet (the others as they were).
     fn sync<S: OrbitSpace<N>, const N: usize>(&mut self, space: &S, points: &[S::Point]) {
         let base = points.len();
         self.keys.truncate(base);
@@ -365,6 +366,13 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.threads = threads.map_or(0, |n| n.max(1));
     }
 
+    /// Ends a batch of [`Self::insert_parallel`] calls (the rounds of one build or one
+    /// `insert_all`): the points' keys kept between them are dropped, so that removals and
+    /// moves before the next batch cannot leave them stale.
+    pub fn end_batch(&mut self) {
+        self.wave_keys = Vec::new();
+    }
+
     /// The threads of the parallel bulk insertion, if any ([`Self::set_threads`]).
     pub fn threads(&self) -> Option<usize> {
         (self.threads > 0).then_some(self.threads)
@@ -388,7 +396,8 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// is stored the same, slot for slot, whatever their number. `progress` is called with
     /// the number of items done: with 0 first, then every 4096 items one by one and after
     /// each wave (not at the end); [`ControlFlow::Break`] stops the insertion (the items
-    /// not yet done are not in the log).
+    /// not yet done are not in the log). The points' keys are kept for the next call until
+    /// [`Self::end_batch`].
     pub fn insert_parallel(
         &mut self,
         items: &[Item<S::Point>],
@@ -967,7 +976,7 @@ mod tests {
     use super::{Ownership, FEWEST};
     use crate::delaunay::Engine;
     use crate::sort::SplitMix;
-    use crate::space::FlatTorus3;
+    use crate::space::{FlatTorus3, OrbitSpace};
 
     #[test]
     fn a_wave_needs_threads_a_guaranteed_quotient_and_a_32nd_of_the_points() {
@@ -985,6 +994,37 @@ mod tests {
         assert!(!e.wave_ready(fewest - 1) && !e.wave_ready(0));
         e.set_threads(None);
         assert!(!e.wave_ready(fewest));
+    }
+
+    #[test]
+    fn the_keys_stay_from_call_to_call_until_the_batch_ends() {
+        let mut e = Engine::new(FlatTorus3::cuboid([1.0; 3]).unwrap());
+        e.set_threads(Some(2));
+        let mut r = SplitMix::new(5);
+        let mut batch = |n: usize, e: &Engine<FlatTorus3, 4>| -> Vec<super::Item<[f64; 3]>> {
+            let mut items: Vec<_> = (0..n as u32)
+                .map(|k| {
+                    let p = [r.unit(), r.unit(), r.unit()];
+                    (k, p, 0.0, e.space.spatial_key(&p))
+                })
+                .collect();
+            items.sort_by_key(|it| it.3);
+            items
+        };
+        let go = |_| std::ops::ControlFlow::Continue(());
+        // 2048 one at a time, then a wave: every point's key is kept
+        let items = batch(5000, &e);
+        assert!(e.insert_parallel(&items, go).1.is_continue());
+        assert_eq!(e.wave_keys.len(), e.points.len());
+        let keys: Vec<u64> = e.points.iter().map(|p| e.space.spatial_key(p)).collect();
+        assert_eq!(e.wave_keys, keys);
+        // too few for a wave: nothing computed, nothing dropped
+        let items = batch(100, &e);
+        assert!(e.insert_parallel(&items, go).1.is_continue());
+        assert_eq!(e.wave_keys.len(), 5000);
+        e.end_batch();
+        assert!(e.wave_keys.is_empty());
+        assert!(e.is_valid().is_ok());
     }
 
     #[test]

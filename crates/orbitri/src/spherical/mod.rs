@@ -433,7 +433,7 @@ impl<S: SphericalSpace> SphericalTriangulation<S> {
     ) -> Result<()> {
         let mut done = 0;
         let stored = |i: u32| S::representative(points[i as usize]);
-        crate::sort::in_rounds(
+        let outcome = crate::sort::in_rounds(
             points.len(),
             Some(seed),
             |i| sphere_key(&stored(i)),
@@ -449,7 +449,9 @@ impl<S: SphericalSpace> SphericalTriangulation<S> {
                 done += items.len();
                 Ok(())
             },
-        )
+        );
+        self.engine.end_batch();
+        outcome
     }
 
     /// Inserts `items` (tagged with their input ids) by the engine's parallel insertion,

@@ -447,6 +447,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
                 }
             },
         );
+        self.engine.end_batch();
         match outcome {
             Ok(()) => Ok(true),
             Err(None) => Ok(false),
