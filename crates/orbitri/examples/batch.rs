@@ -11,13 +11,10 @@ use std::time::Instant;
 use orbitri::{FlatTorus3, PeriodicDelaunay3};
 
 mod common;
-use common::{median, uniform};
+use common::{median, numbers, uniform};
 
 fn main() {
-    let args: Vec<usize> = std::env::args()
-        .skip(1)
-        .map(|a| a.parse().expect("numbers"))
-        .collect();
+    let args = numbers();
     let reps = args.first().copied().unwrap_or(3);
     let ns = if args.len() > 1 {
         args[1..].to_vec()

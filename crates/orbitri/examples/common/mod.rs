@@ -14,3 +14,11 @@ pub fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
     v[v.len() / 2]
 }
+
+/// The command line's arguments, all numbers.
+pub fn numbers() -> Vec<usize> {
+    std::env::args()
+        .skip(1)
+        .map(|a| a.parse().expect("numbers"))
+        .collect()
+}

@@ -148,8 +148,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sort::SplitMix;
-    use crate::space::FlatTorus3;
+    use crate::delaunay::uniform_cube;
 
     /// Every grid cell names none or a vertex whose point has that key prefix.
     fn grid_is_true<S: OrbitSpace<N>, const N: usize>(e: &Engine<S, N>) -> usize {
@@ -164,11 +163,7 @@ mod tests {
 
     #[test]
     fn the_grid_follows_the_points_through_renumbering() {
-        let mut e = Engine::new(FlatTorus3::cuboid([1.0; 3]).unwrap());
-        let mut r = SplitMix::new(7);
-        for _ in 0..3000 {
-            e.insert([r.unit(), r.unit(), r.unit()]);
-        }
+        let mut e = uniform_cube(3000, 7);
         assert!(e.is_one_sheeted());
         let before = e.locator.slots.clone();
         let full = grid_is_true(&e);

@@ -686,3 +686,15 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         }
     }
 }
+
+/// A unit cube torus with `n` uniform random points (seed `seed`) inserted one at a time:
+/// the engine the module's unit tests start from.
+#[cfg(test)]
+fn uniform_cube(n: usize, seed: u64) -> Engine<crate::space::FlatTorus3, 4> {
+    let mut e = Engine::new(crate::space::FlatTorus3::cuboid([1.0; 3]).unwrap());
+    let mut r = SplitMix::new(seed);
+    for _ in 0..n {
+        e.insert([r.unit(), r.unit(), r.unit()]);
+    }
+    e
+}

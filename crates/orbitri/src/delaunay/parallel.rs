@@ -3,23 +3,23 @@
 //! The points arrive in BRIO + Hilbert order. After a short sequential start they go in
 //! waves, each of the next as many points as there are (so that a wave at most doubles the
 //! triangulation); when fewer than a 32nd of the points are left in the call (a BRIO
-//! round), they go one at a time. A wave is sorted along the Hilbert curve and cut into [`CHUNKS`] chunks
-//! of consecutive points, and each chunk **owns** the cells of its stretch of the curve: a
-//! cell belongs to the chunk whose range holds the spatial key of its vertex 0, and a new
-//! cell to the chunk that made it. A chunk inserts its points one after another, as a
-//! sequential insertion would (each walk starts from its last insertion, or every 64th from
-//! a cell located before the pass), but only where it owns everything it reads or writes:
-//! the walk, the conflict region and the cells across its boundary. A point that needs
-//! another chunk's cell, or whose 3D star the ridge table refuses, is deferred. The chunks
-//! run on
-//! the threads in any order and at once, with no lock: a cell next to a chunk's own cell
-//! cannot change while it is, since changing it would write the chunk's cell.
+//! round), they go one at a time. A wave is sorted along the Hilbert curve and cut into
+//! [`CHUNKS`] chunks of consecutive points, and each chunk **owns** the cells of its stretch
+//! of the curve: a cell belongs to the chunk whose range holds the spatial key of its
+//! vertex 0, and a new cell to the chunk that made it. A chunk inserts its points one after
+//! another, as a sequential insertion would (each walk starts from its last insertion, or
+//! every 64th from a cell located before the pass), but only where it owns everything it
+//! reads or writes: the walk, the conflict region and the cells across its boundary. A
+//! point that needs another chunk's cell, or whose 3D star the ridge table refuses, is
+//! deferred. The chunks run on the threads in any order and at once, with no lock: a cell
+//! next to a chunk's own cell cannot change while it is, since changing it would write the
+//! chunk's cell.
 //!
-//! The deferred points, on the chunks' borders (a quarter of the last wave of 10⁶ uniform
-//! points in a cube), then go in one after another by the sequential code. Each point of the wave had its id reserved at the start, in
-//! curve order; the ids of points that did not become vertices (duplicates, and the
-//! sphere's points that would hide others, inserted last by the sequential code) are
-//! filled by the last points.
+//! The deferred points, on the chunks' borders (a fifth of the last wave of 10⁶ uniform
+//! points in a cube), then go in one after another by the sequential code. Each point of
+//! the wave had its id reserved at the start, in curve order; the ids of points that did
+//! not become vertices (duplicates, and the sphere's points that would hide others,
+//! inserted last by the sequential code) are filled by the last points.
 //!
 //! Nothing depends on the number of threads or on timing: a chunk's work depends only on
 //! its own cells, its points and its reserved cell slots, so every thread count stores the
@@ -410,11 +410,11 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         let mut shared = Shared {
             keys: std::mem::take(&mut self.wave_keys),
         };
-        let mut k = 0;
+        let (mut k, mut flow) = (0, ControlFlow::Continue(()));
         while k < items.len() {
             if progress(k).is_break() {
-                self.wave_keys = shared.keys;
-                return (log, ControlFlow::Break(()));
+                flow = ControlFlow::Break(());
+                break;
             }
             if self.wave_ready(items.len() - k) {
                 let m = (items.len() - k).min(self.points.len());
@@ -429,7 +429,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             }
         }
         self.wave_keys = shared.keys;
-        (log, ControlFlow::Continue(()))
+        (log, flow)
     }
 
     /// Inserts item `k` with the sequential code and logs it.
@@ -974,17 +974,13 @@ fn orphans_of<const N: usize>(
 #[cfg(test)]
 mod tests {
     use super::{Ownership, FEWEST};
-    use crate::delaunay::Engine;
+    use crate::delaunay::{uniform_cube, Engine};
     use crate::sort::SplitMix;
     use crate::space::{FlatTorus3, OrbitSpace};
 
     #[test]
     fn a_wave_needs_threads_a_guaranteed_quotient_and_a_32nd_of_the_points() {
-        let mut e = Engine::new(FlatTorus3::cuboid([1.0; 3]).unwrap());
-        let mut r = SplitMix::new(3);
-        for _ in 0..4000 {
-            e.insert([r.unit(), r.unit(), r.unit()]);
-        }
+        let mut e = uniform_cube(4000, 3);
         assert!(e.is_one_sheeted() && e.guaranteed);
         let n = e.points.len();
         let fewest = n.div_ceil(FEWEST);

@@ -113,16 +113,12 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
 
 #[cfg(test)]
 mod tests {
-    use crate::sort::SplitMix;
+    use crate::delaunay::uniform_cube;
     use crate::space::FlatTorus3;
     use crate::Engine;
 
     fn engine() -> Engine<FlatTorus3, 4> {
-        let mut e = Engine::new(FlatTorus3::cuboid([1.0; 3]).unwrap());
-        let mut r = SplitMix::new(3);
-        for _ in 0..400 {
-            e.insert([r.unit(), r.unit(), r.unit()]);
-        }
+        let e = uniform_cube(400, 3);
         assert!(e.is_one_sheeted());
         e.is_valid().unwrap();
         e
