@@ -124,24 +124,40 @@ pub fn hilbert<const D: usize>(mut x: [u32; D], bits: u32) -> u64 {
     h
 }
 
+/// A BRIO order: rounds drawn by `seed`, each `2^growth` times larger than the one before
+/// it (the last holds `1 − 2^−growth` of the items).
+#[derive(Clone, Copy, Debug)]
+pub struct Brio {
+    pub seed: u64,
+    pub growth: u32,
+}
+
+impl Brio {
+    /// Rounds that double: the parallel insertion's waves, each at most doubling the
+    /// triangulation, cut them into parts the size of everything inserted before.
+    pub fn doubling(seed: u64) -> Self {
+        Brio { seed, growth: 1 }
+    }
+}
+
 /// The BRIO rounds of `n` items: their indices grouped by round, in index order within
-/// each, and where each round starts (one entry more: `n`). The rounds double in size (the
-/// last holds about half the items, the first about 64). An item's round is drawn from a
-/// hash of its index and `seed` (the tails before the first head of a fair coin, counted
-/// back from the last round), so that the rounds are filled in one pass over the items in
-/// memory order: no shuffle, no lookup at a random place.
-pub fn brio_rounds(n: usize, seed: u64) -> (Vec<u32>, Vec<usize>) {
+/// each, and where each round starts (one entry more: `n`). The rounds grow by `2^growth`
+/// (the first holds about 64 items). An item's round is drawn from a hash of its index and
+/// the seed (the tails before the first head of a fair coin, `growth` tosses a step,
+/// counted back from the last round), so that the rounds are filled in one pass over the
+/// items in memory order: no shuffle, no lookup at a random place.
+pub fn brio_rounds(n: usize, Brio { seed, growth }: Brio) -> (Vec<u32>, Vec<usize>) {
     let mut last = 0;
     let mut m = n;
     while m > 64 {
-        m /= 2;
+        m >>= growth;
         last += 1;
     }
     let round: Vec<u8> = (0..n)
         .into_par_iter()
         .map(|i| {
             let h = SplitMix::new(seed ^ (i as u64).wrapping_mul(0xD6E8_FEB8_6659_FD93)).next_u64();
-            (last - (h.trailing_zeros() as usize).min(last)) as u8
+            (last - ((h.trailing_zeros() / growth) as usize).min(last)) as u8
         })
         .collect();
     let mut start = vec![0usize; last + 2];
@@ -160,27 +176,27 @@ pub fn brio_rounds(n: usize, seed: u64) -> (Vec<u32>, Vec<usize>) {
     (idx, start)
 }
 
-/// Feeds the BRIO rounds of `n` items ([`brio_rounds`] by `seed`) to `consume` in order,
+/// Feeds the BRIO rounds of `n` items ([`brio_rounds`] by `order`) to `consume` in order,
 /// each as `(key, index)` pairs sorted by `key` and made ready by `prepare` (it gathers the
 /// items) on a helper thread while the round before it is consumed: the insertion order,
 /// a tenth of a build when done up front, hides behind the insertion, which takes ten
-/// times longer a point. Without a seed, all items in their order as one round, unsorted.
+/// times longer a point. Without an order, all items in their order as one round, unsorted.
 /// Stops at `consume`'s first error. (Below 2¹⁴ items, all on the caller's thread.)
 pub fn in_rounds<T: Send, E>(
     n: usize,
-    seed: Option<u64>,
+    order: Option<Brio>,
     key: impl Fn(u32) -> u64 + Sync,
     prepare: impl Fn(Vec<(u64, u32)>) -> T + Sync,
     mut consume: impl FnMut(T) -> Result<(), E>,
 ) -> Result<(), E> {
-    let (idx, start) = match seed {
-        Some(seed) => brio_rounds(n, seed),
+    let (idx, start) = match order {
+        Some(order) => brio_rounds(n, order),
         None => ((0..n as u32).collect(), vec![0, n]),
     };
     // (one thread: a round is sorted while another is inserted)
     let ready = |round: &[u32]| {
         let mut pairs: Vec<(u64, u32)> = round.iter().map(|&i| (key(i), i)).collect();
-        if seed.is_some() {
+        if order.is_some() {
             pairs.sort_unstable();
         }
         prepare(pairs)
@@ -323,11 +339,11 @@ mod tests {
     }
 
     /// The indices of `keys` in the order [`in_rounds`] feeds them.
-    fn fed_order(keys: &[u64], seed: u64) -> Vec<u32> {
+    fn fed_order(keys: &[u64], order: Brio) -> Vec<u32> {
         let mut fed = Vec::new();
         let all: Result<(), ()> = in_rounds(
             keys.len(),
-            Some(seed),
+            Some(order),
             |i| keys[i as usize],
             |round| round,
             |round| {
@@ -340,31 +356,34 @@ mod tests {
     }
 
     #[test]
-    fn brio_is_a_permutation_with_sorted_rounds() {
-        let keys: Vec<u64> = (0..1000u64).map(|i| (i * 7919) % 1000).collect();
-        let order = fed_order(&keys, 3);
-        let mut seen = order.clone();
-        seen.sort_unstable();
-        assert_eq!(seen, (0..1000).collect::<Vec<u32>>());
-        // sorted runs, about one a round, the last about half the items
-        let descents = order
-            .windows(2)
-            .filter(|w| keys[w[0] as usize] > keys[w[1] as usize])
-            .count();
-        assert!(
-            (3..=4).contains(&descents),
-            "{descents} rounds after the first"
-        );
-        let tail = order
-            .iter()
-            .rev()
-            .zip(order.iter().rev().skip(1))
-            .take_while(|(a, b)| keys[**b as usize] <= keys[**a as usize])
-            .count();
-        assert!(
-            (400..600).contains(&tail),
-            "the last round holds {tail} items"
-        );
+    fn brio_is_a_permutation_with_sorted_rounds_growing_as_asked() {
+        // (growth, rounds after the first, the last round's share in thousandths)
+        for (growth, later, last) in [(1, 3..=4, 400..600), (3, 1..=2, 820..930)] {
+            let keys: Vec<u64> = (0..1000u64).map(|i| (i * 7919) % 1000).collect();
+            let order = fed_order(&keys, Brio { seed: 3, growth });
+            let mut seen = order.clone();
+            seen.sort_unstable();
+            assert_eq!(seen, (0..1000).collect::<Vec<u32>>());
+            // sorted runs, one a round
+            let descents = order
+                .windows(2)
+                .filter(|w| keys[w[0] as usize] > keys[w[1] as usize])
+                .count();
+            assert!(
+                later.contains(&descents),
+                "growth {growth}: {descents} rounds after the first"
+            );
+            let tail = order
+                .iter()
+                .rev()
+                .zip(order.iter().rev().skip(1))
+                .take_while(|(a, b)| keys[**b as usize] <= keys[**a as usize])
+                .count();
+            assert!(
+                last.contains(&tail),
+                "growth {growth}: the last round holds {tail} items"
+            );
+        }
     }
 
     #[test]
@@ -378,19 +397,19 @@ mod tests {
     fn rounds_in_order(n: u64) {
         let keys: Vec<u64> = (0..n).map(|i| (i * 7919) % n).collect();
         // each round of `brio_rounds`, sorted by key here
-        let (idx, start) = brio_rounds(keys.len(), 9);
+        let (idx, start) = brio_rounds(keys.len(), Brio::doubling(9));
         let mut expected = Vec::new();
         for r in start.windows(2) {
             let mut round = idx[r[0]..r[1]].to_vec();
             round.sort_by_key(|&i| keys[i as usize]);
             expected.extend(round);
         }
-        assert_eq!(fed_order(&keys, 9), expected);
+        assert_eq!(fed_order(&keys, Brio::doubling(9)), expected);
         // a consumer that stops after three rounds: the helper stops too (no hang)
         let mut rounds = 0;
         let stopped = in_rounds(
             keys.len(),
-            Some(9),
+            Some(Brio::doubling(9)),
             |i| keys[i as usize],
             |round| round,
             |_| {

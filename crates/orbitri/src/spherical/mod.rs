@@ -28,6 +28,7 @@ use crate::error::{Error, Result};
 use crate::ids::{CellId, InputId, PointId};
 use crate::predicates::spherical::{orient_origin, side_of_circle};
 use crate::predicates::Sign;
+use crate::sort::Brio;
 use crate::space::{
     projective_representative, sphere_key, Antipode, OrbitSpace, ProjectivePlane, Sphere,
 };
@@ -435,7 +436,7 @@ impl<S: SphericalSpace> SphericalTriangulation<S> {
         let stored = |i: u32| S::representative(points[i as usize]);
         let outcome = crate::sort::in_rounds(
             points.len(),
-            Some(seed),
+            Some(Brio::doubling(seed)),
             |i| sphere_key(&stored(i)),
             // the stored representatives, gathered with their keys
             |round| -> Vec<Item<[f64; 3]>> {

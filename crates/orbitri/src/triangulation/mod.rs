@@ -18,6 +18,7 @@ use rayon::prelude::*;
 use crate::delaunay::{Engine, HiddenPoint, Inserted, Invalid, Item, Moved, Removal};
 use crate::error::{Error, Result};
 use crate::ids::{CellId, InputId, PointId, VertexId};
+use crate::sort::Brio;
 use crate::space::{FlatManifold, FlatSpace, FlatTorus, OrbitSpace};
 
 /// Offset of a vertex in lattice-vector units.
@@ -429,10 +430,20 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     ) -> Result<bool> {
         let space = self.space().clone();
         let key = |k: u32| space.spatial_key(&points[k as usize]);
+        // one at a time in 2D, rounds that grow eightfold (the last holds seven eighths of
+        // the points) keep consecutive points in the cells just made: 6 % off a build of
+        // 10⁶ points in a square (none in a cube or on the sphere); the parallel insertion
+        // cuts its waves from doubling rounds
+        let growth = if D == 2 && self.engine.threads().is_none() {
+            3
+        } else {
+            1
+        };
+        let order = seed.map(|seed| Brio { seed, growth });
         let mut done = 0;
         let outcome = crate::sort::in_rounds(
             points.len(),
-            seed,
+            order,
             key,
             |round| round,
             |round| {
