@@ -317,6 +317,11 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     /// lattice translation, which the offsets of the point's star absorb.
     fn represent_first_occurrences(&mut self, wrapped: &[[f64; D]]) {
         for p in 0..self.point_input.len() {
+            // (the inputs in a random order: loaded ahead)
+            let ahead = self.point_input.get(p + Self::AHEAD);
+            if let Some(w) = ahead.and_then(|i| wrapped.get(i.index())) {
+                crate::tds::prefetch(w);
+            }
             self.represent(PointId::new(p), wrapped[self.point_input[p].index()]);
         }
     }
@@ -466,6 +471,9 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         }
     }
 
+    /// How many points ahead of the insertion their data are loaded.
+    const AHEAD: usize = 8;
+
     /// [`Self::insert_ordered`] of one round, `(spatial key, index)` pairs in insertion
     /// order, after `done` points. One at a time unless the engine has threads: the
     /// parallel insertion's items and log cost 56 bytes a point more at the peak (435 →
@@ -484,9 +492,11 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
                 if (done + n) % 4096 == 0 {
                     proceed(progress, done + n)?;
                 }
-                // (the points come in a random order: loaded ahead)
-                if let Some(&(_, ahead)) = round.get(n + 8) {
+                // (the points come in a random order: each point, and its entry in the
+                // input table that `record` writes, loaded ahead)
+                if let Some(&(_, ahead)) = round.get(n + Self::AHEAD) {
                     crate::tds::prefetch(&points[ahead as usize]);
+                    self.prefetch_input(first + ahead as usize);
                 }
                 let k = k as usize;
                 let (p, w) = (points[k], weight(k));
@@ -511,7 +521,10 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         if flow.is_break() {
             return Err(Error::Interrupted);
         }
-        for (k, r, hid) in log.iter() {
+        for (n, (k, r, hid)) in log.iter().enumerate() {
+            if let Some(&(ahead, ..)) = log.events.get(n + Self::AHEAD) {
+                self.prefetch_input(items[ahead as usize].0 as usize);
+            }
             if !keep(r, hid) {
                 return Ok(false);
             }
@@ -520,6 +533,16 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             self.record(InputId(i), p, w, r);
         }
         Ok(true)
+    }
+
+    /// Loads the entry of input `i` in the input table, which [`Self::record`] will write:
+    /// the inputs come in a random order, and loading each entry ahead took 13 % off a
+    /// build of 10⁶ points in a square (3 % in a cube).
+    #[inline(always)]
+    fn prefetch_input(&self, i: usize) {
+        if let Some(entry) = self.input_point.get(i) {
+            crate::tds::prefetch(entry);
+        }
     }
 
     /// Input `i` became point `p`, after the points it hid left (each renumbering the last
