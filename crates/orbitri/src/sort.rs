@@ -124,25 +124,34 @@ pub fn hilbert<const D: usize>(mut x: [u32; D], bits: u32) -> u64 {
     h
 }
 
-/// A BRIO order: rounds drawn by `seed`, each `2^growth` times larger than the one before
+/// A BRIO order: rounds drawn by a seed, each `2^growth` times larger than the one before
 /// it (the last holds `1 − 2^−growth` of the items).
 #[derive(Clone, Copy, Debug)]
 pub struct Brio {
-    pub seed: u64,
-    pub growth: u32,
+    seed: u64,
+    growth: u32,
 }
 
 impl Brio {
-    /// Rounds that double: the parallel insertion's waves, each at most doubling the
-    /// triangulation, cut them into parts the size of everything inserted before.
+    /// Rounds growing by `2^growth`, `growth` from 1 to 63 (it panics otherwise).
+    pub fn new(seed: u64, growth: u32) -> Self {
+        assert!(
+            (1..64).contains(&growth),
+            "BRIO growth {growth} not in 1..64"
+        );
+        Brio { seed, growth }
+    }
+
+    /// Rounds that double, each about as large as all before it (a parallel wave, at most
+    /// doubling the triangulation, then takes about one round).
     pub fn doubling(seed: u64) -> Self {
-        Brio { seed, growth: 1 }
+        Brio::new(seed, 1)
     }
 }
 
 /// The BRIO rounds of `n` items: their indices grouped by round, in index order within
 /// each, and where each round starts (one entry more: `n`). The rounds grow by `2^growth`
-/// (the first holds about 64 items). An item's round is drawn from a hash of its index and
+/// (the first holds at most about 64 items). An item's round is drawn from a hash of its index and
 /// the seed (the tails before the first head of a fair coin, `growth` tosses a step,
 /// counted back from the last round), so that the rounds are filled in one pass over the
 /// items in memory order: no shuffle, no lookup at a random place.
@@ -357,33 +366,36 @@ mod tests {
 
     #[test]
     fn brio_is_a_permutation_with_sorted_rounds_growing_as_asked() {
-        // (growth, rounds after the first, the last round's share in thousandths)
-        for (growth, later, last) in [(1, 3..=4, 400..600), (3, 1..=2, 820..930)] {
-            let keys: Vec<u64> = (0..1000u64).map(|i| (i * 7919) % 1000).collect();
-            let order = fed_order(&keys, Brio { seed: 3, growth });
-            let mut seen = order.clone();
+        let keys: Vec<u64> = (0..1000u64).map(|i| (i * 7919) % 1000).collect();
+        // (growth, rounds, the last round's share in thousandths: 1 − 2^−growth)
+        for (growth, rounds, last) in [(1, 5, 450..550), (3, 3, 830..920)] {
+            let order = Brio::new(3, growth);
+            let (idx, start) = brio_rounds(keys.len(), order);
+            let sizes: Vec<usize> = start.windows(2).map(|r| r[1] - r[0]).collect();
+            assert_eq!(sizes.len(), rounds, "growth {growth}: {sizes:?}");
+            assert!(
+                last.contains(&sizes[rounds - 1]),
+                "growth {growth}: {sizes:?}"
+            );
+            // fed: a permutation, sorted by key within each round
+            let fed = fed_order(&keys, order);
+            let mut seen = fed.clone();
             seen.sort_unstable();
             assert_eq!(seen, (0..1000).collect::<Vec<u32>>());
-            // sorted runs, one a round
-            let descents = order
-                .windows(2)
-                .filter(|w| keys[w[0] as usize] > keys[w[1] as usize])
-                .count();
-            assert!(
-                later.contains(&descents),
-                "growth {growth}: {descents} rounds after the first"
-            );
-            let tail = order
-                .iter()
-                .rev()
-                .zip(order.iter().rev().skip(1))
-                .take_while(|(a, b)| keys[**b as usize] <= keys[**a as usize])
-                .count();
-            assert!(
-                last.contains(&tail),
-                "growth {growth}: the last round holds {tail} items"
-            );
+            let mut at = 0;
+            for r in start.windows(2) {
+                let mut round = idx[r[0]..r[1]].to_vec();
+                round.sort_by_key(|&i| keys[i as usize]);
+                assert_eq!(fed[at..at + round.len()], round[..], "growth {growth}");
+                at += round.len();
+            }
         }
+    }
+
+    #[test]
+    #[should_panic(expected = "BRIO growth 0")]
+    fn brio_growth_must_be_positive() {
+        Brio::new(1, 0);
     }
 
     #[test]

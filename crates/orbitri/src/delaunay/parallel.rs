@@ -211,8 +211,9 @@ struct Shared {
 
 impl Shared {
     /// The keys of `points[..base]`: those not computed yet (the others as they were), on
-    /// the threads (the first wave of a batch into a large triangulation computes them all:
-    /// at 10⁶ points in a cube, 150 ms on one thread, 75 ms on two).
+    /// rayon's threads (the caller's pool, as the pass's; the first wave of a batch into a
+    /// large triangulation computes them all: at 10⁶ points in a cube, 150 ms on one
+    /// thread, 75 ms on two).
     fn sync<S: OrbitSpace<N>, const N: usize>(&mut self, space: &S, points: &[S::Point]) {
         let base = points.len();
         self.keys.truncate(base);

@@ -436,15 +436,15 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         let space = self.space().clone();
         let key = |k: u32| space.spatial_key(&points[k as usize]);
         // one at a time in 2D, rounds that grow eightfold (the last holds seven eighths of
-        // the points) keep consecutive points in the cells just made: 6 % off a build of
-        // 10⁶ points in a square (none in a cube or on the sphere); the parallel insertion
-        // cuts its waves from doubling rounds
+        // the points) keep consecutive points in the cells just made: 8 % off a build of
+        // 10⁶ points in a square (none in a cube or on the sphere; BENCHMARKS.md); the
+        // parallel insertion cuts its waves from doubling rounds
         let growth = if D == 2 && self.engine.threads().is_none() {
             3
         } else {
             1
         };
-        let order = seed.map(|seed| Brio { seed, growth });
+        let order = seed.map(|seed| Brio::new(seed, growth));
         let mut done = 0;
         let outcome = crate::sort::in_rounds(
             points.len(),
@@ -536,7 +536,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     }
 
     /// Loads the entry of input `i` in the input table, which [`Self::record`] will write:
-    /// the inputs come in a random order, and loading each entry ahead took 13 % off a
+    /// the inputs come in a random order, and loading each entry ahead took 16 % off a
     /// build of 10⁶ points in a square (3 % in a cube).
     #[inline(always)]
     fn prefetch_input(&self, i: usize) {
