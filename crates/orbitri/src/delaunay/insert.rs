@@ -6,7 +6,7 @@ use crate::ids::{CellId, PointId, VertexId};
 use crate::predicates::Sign;
 use crate::sort::SplitMix;
 use crate::space::OrbitSpace;
-use crate::tds::Cell;
+use crate::tds::{replaced, Cell};
 
 /// Why a lifted point was not inserted.
 pub(crate) enum Refused {
@@ -345,9 +345,11 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     ) -> (CellId, Cell<S::Elem, N>) {
         let (c, qo) = scratch.conflict[ci as usize];
         let cell = self.tds.cells[c.index()];
-        let (mut v, mut off) = (cell.v, cell.off);
-        (v[i as usize], off[i as usize]) = (x, qo);
-        (self.make_cell(v, off), cell)
+        let i = i as usize;
+        (
+            self.make_cell(replaced(cell.v, i, x), replaced(cell.off, i, qo)),
+            cell,
+        )
     }
 
     /// The slot of vertex `y` in the new 2D cell `c` built on edge `i` of a conflict cell.

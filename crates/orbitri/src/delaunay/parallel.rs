@@ -40,7 +40,7 @@ use super::{Engine, HiddenPoint, Inserted};
 use crate::ids::{CellId, PointId, VertexId};
 use crate::sort::SplitMix;
 use crate::space::OrbitSpace;
-use crate::tds::Cell;
+use crate::tds::{replaced, Cell};
 
 /// Points inserted one by one before the waves.
 const SEQUENTIAL_START: usize = 2048;
@@ -879,15 +879,16 @@ unsafe fn commit<S: OrbitSpace<N>, const N: usize>(
     new.clear();
     for (k, &(ci, i)) in ch.boundary.iter().enumerate() {
         let (ci, i) = (ci as usize, i as usize);
-        let mut cell = old[ci];
-        cell.v[i] = x;
-        cell.off[i] = ch.conflict[ci].1;
-        let mut cell = Cell::new(cell.v, cell.off);
+        let was = &old[ci];
+        let mut cell = Cell::new(
+            replaced(was.v, i, x),
+            replaced(was.off, i, ch.conflict[ci].1),
+        );
         if space.normalize(&mut cell.off, level) && S::MAY_REVERSE {
             cell.swap_slots(0, 1);
         }
         let slot = cell.index_of(x).expect("the new vertex");
-        cell.n[slot] = ch.across[k].0;
+        cell.n = replaced(cell.n, slot, ch.across[k].0);
         new.push(cell);
     }
     // 3D: paired by the boundary edges (as [`Engine::link_by_ridges`] pairs them)

@@ -71,6 +71,13 @@ fn first_equal<T: PartialEq + Copy, const N: usize>(a: &[T; N], x: T) -> Option<
     (mask != 0).then(|| mask.trailing_zeros() as usize)
 }
 
+/// `a` with `x` in slot `i`, chosen slot by slot (where a store into a computed slot
+/// followed by a copy of the whole cell waits for the store).
+#[inline(always)]
+pub fn replaced<T: Copy, const N: usize>(a: [T; N], i: usize, x: T) -> [T; N] {
+    std::array::from_fn(|k| if k == i { x } else { a[k] })
+}
+
 /// Asks the processor to start loading `x` into its caches (a hint: nothing on other
 /// architectures).
 #[inline(always)]
@@ -232,6 +239,14 @@ mod tests {
             assert_eq!(cell.index_of(VertexId(v)), Some(k));
         }
         assert_eq!(cell.index_of(VertexId(4)), None);
+    }
+
+    #[test]
+    fn replaced_changes_one_slot_only() {
+        assert_eq!(replaced([1, 2, 3, 4], 2, 9), [1, 2, 9, 4]);
+        assert_eq!(replaced([1, 2, 3], 0, 7), [7, 2, 3]);
+        // a slot past the end changes nothing
+        assert_eq!(replaced([1, 2, 3], 3, 7), [1, 2, 3]);
     }
 
     #[test]
