@@ -15,8 +15,14 @@
 //! next to a chunk's own cell cannot change while it is, since changing it would write the
 //! chunk's cell.
 //!
-//! The deferred points, on the chunks' borders (a fifth of the last wave of 10⁶ uniform
-//! points in a cube), then go in one after another by the sequential code. Each point of
+//! The deferred points lie on the chunks' borders (a fifth of the last wave of 10⁶ uniform
+//! points in a cube). Each remembers the chunk whose cell stopped it; those stopped on the
+//! border between chunks `2j` and `2j + 1` then go in by groups of two chunks, which own
+//! their chunks' cells (the border now inside one of them), those between chunks of one
+//! aligned group of four by groups of four, and so on while there are two groups (in that
+//! cube, a third of the deferred points at each level). The rest, and every level with
+//! fewer than [`GROUPED_FEWEST`] points, go in one after another by the sequential code
+//! (that cube's last wave: 100 000 → 36 000 points). Each point of
 //! the wave had its id reserved at the start, in curve order; the ids of points that did
 //! not become vertices (duplicates, and the sphere's points that would hide others,
 //! inserted last by the sequential code) are filled by the last points.
@@ -52,6 +58,15 @@ const CHUNKS: usize = 8;
 /// stamps every cell first (20 ms at 10⁶ points in a square, 30 ms in a cube), which a
 /// smaller wave (the tail of a BRIO round, a small batch) saves by going one at a time.
 const FEWEST: usize = 32;
+/// Visit marks a chunk has room for, per point of its share: two (an inside and an outside
+/// one) each time a point is tried, in its chunk and in the groups of 2, 4, … chunks that
+/// take the points left on their inner borders (at most `2·(1 + 2 + 4)` for 8 chunks).
+const MARKS: usize = 16;
+/// The fewest points left on the chunks' borders that go in by groups of chunks: fewer go
+/// in one at a time, which costs less than setting up the groups (on a surface, where
+/// the borders are curves, they are 3 % of a wave of 10⁶ points, and grouping them made
+/// the sphere 5 % slower).
+const GROUPED_FEWEST: usize = 8192;
 /// Cell slots reserved for a chunk beyond its points' share.
 const MARGIN: usize = 64;
 
@@ -137,6 +152,10 @@ struct Chunk<O, const N: usize> {
     across: Vec<(CellId, u8)>,
     /// The visit marks taken so far from the chunk's stamps ([`Ownership::mark`]).
     marks: u32,
+    /// The chunk of the pass that owns the cell which stopped the current probe, if known.
+    foreign: Option<u32>,
+    /// The points it left: (position in the wave, `foreign` then).
+    left: Vec<(u32, Option<u32>)>,
     /// 2D: the boundary edges' ends in the order of a walk around the region with the
     /// facet across, and the search's stack (see [`Engine::probe_around`]).
     rim: Vec<(VertexId, VertexId, u8)>,
@@ -158,9 +177,9 @@ struct Chunk<O, const N: usize> {
 }
 
 impl<O, const N: usize> Chunk<O, N> {
-    fn new(id: usize, range: Range<usize>, spare: Vec<CellId>, fresh: Range<usize>) -> Self {
+    fn new(id: u32, range: Range<usize>, spare: Vec<CellId>, fresh: Range<usize>) -> Self {
         Chunk {
-            id: id as u32,
+            id,
             range,
             hint: None,
             starts: Vec::new(),
@@ -170,6 +189,8 @@ impl<O, const N: usize> Chunk<O, N> {
             boundary: Vec::new(),
             across: Vec::new(),
             marks: 0,
+            foreign: None,
+            left: Vec::new(),
             rim: Vec::new(),
             stack: Vec::new(),
             spare,
@@ -235,6 +256,9 @@ struct Ownership {
     /// [`crate::tds::Tds::reserve_stamps`]).
     first: u32,
     shift: u32,
+    /// The chunks merge in aligned groups of `2^level` (0 for the pass's own chunks):
+    /// a group owns every cell of its chunks.
+    level: u32,
 }
 
 impl Ownership {
@@ -249,16 +273,22 @@ impl Ownership {
         shift.min(30 - count.next_power_of_two().trailing_zeros())
     }
 
-    /// The chunk owning a cell of stamp `s` (`count` or more for none).
+    /// The chunk of the pass that stamped a cell with `s` (`count` or more for none).
     #[inline(always)]
-    fn owner(self, s: u32) -> u32 {
+    fn chunk(self, s: u32) -> u32 {
         s.wrapping_sub(self.first) >> self.shift
     }
 
-    /// The stamp of chunk `j`'s cells.
+    /// The group owning a cell of stamp `s` (`count >> level` or more for none).
+    #[inline(always)]
+    fn owner(self, s: u32) -> u32 {
+        self.chunk(s) >> self.level
+    }
+
+    /// The stamp of group `j`'s cells: its first chunk's.
     #[inline(always)]
     fn stamp(self, j: u32) -> u32 {
-        self.first + (j << self.shift)
+        self.first + ((j << self.level) << self.shift)
     }
 
     /// Chunk `j`'s visit mark `k` (from 1), if it has that many.
@@ -293,6 +323,10 @@ struct Pass<'a, S: OrbitSpace<N>, const N: usize> {
     vcell: &'a [AtomicU32],
     own: Ownership,
     wave: &'a [Item<S::Point>],
+    /// The positions in the wave of the points to insert, chunk after chunk.
+    active: &'a [u32],
+    /// Every this many points of a chunk (a power of two), one was located before the pass.
+    stride: usize,
     /// The id of the wave's first point.
     base: usize,
     chunks: *mut Chunk<S::Elem, N>,
@@ -324,14 +358,16 @@ impl<S: OrbitSpace<N>, const N: usize> Pass<'_, S, N> {
     /// The chunk is this thread's alone.
     unsafe fn run(&self, ch: &mut Chunk<S::Elem, N>) {
         let stamp = self.own.stamp(ch.id);
-        for s in ch.range.clone() {
+        for t in ch.range.clone() {
+            let s = self.active[t] as usize;
             if ch.full {
-                break;
+                ch.left.push((s as u32, None));
+                continue;
             }
-            let k = s - ch.range.start;
-            if k % STRIDE == 0 {
+            let k = t - ch.range.start;
+            if k & (self.stride - 1) == 0 {
                 // (the chunk owned the cell, so only it may have changed it since)
-                if let Some(start) = ch.starts[k / STRIDE] {
+                if let Some(start) = ch.starts[k >> self.stride.trailing_zeros()] {
                     if self.engine.still_there(start) {
                         ch.hint = Some(start);
                     }
@@ -347,15 +383,22 @@ impl<S: OrbitSpace<N>, const N: usize> Pass<'_, S, N> {
                         Commit::Starred => Outcome::New,
                         Commit::OutOfSlots => {
                             ch.full = true;
+                            ch.left.push((s as u32, None));
                             continue;
                         }
-                        Commit::NotSimplicial => continue,
+                        Commit::NotSimplicial => {
+                            ch.left.push((s as u32, None));
+                            continue;
+                        }
                     }
                 }
                 Found::Duplicate(p) => Outcome::Duplicate(p),
                 Found::Hidden => Outcome::Hidden,
                 Found::Alone => Outcome::Alone,
-                Found::Foreign => continue,
+                Found::Foreign => {
+                    ch.left.push((s as u32, ch.foreign));
+                    continue;
+                }
             };
             ch.outcomes.push((s as u32, outcome));
         }
@@ -556,7 +599,10 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
 
     /// The pass of the wave's points (the point at position `s` has id `base + s`) in
     /// [`CHUNKS`] chunks, on the engine's threads: the chunks own the ranges of the
-    /// spatial keys that their points span.
+    /// spatial keys that their points span. Then the points left on the borders between
+    /// chunks `2j` and `2j + 1` go in by [`CHUNKS`]` / 2` groups of two chunks, each
+    /// owning its chunks' cells (the border inside it), those on the borders within
+    /// aligned groups of four by groups of four, and so on while there are two groups.
     fn pass(
         &mut self,
         wave: &[Item<S::Point>],
@@ -566,32 +612,13 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     ) {
         let n = wave.len();
         let count = CHUNKS.min(n.max(1));
-        // cell slots for each chunk: free ones, then new ones (a vertex makes `2` more
-        // triangles on a surface, some 6.8 more tetrahedra in a volume)
-        let per = if N == 3 { 2 } else { 8 };
-        let mut free = self.tds.take_free();
-        let mut slots = self.tds.cells.len();
-        let mut chunks: Vec<Chunk<S::Elem, N>> = (0..count)
-            .map(|j| {
-                let range = j * n / count..(j + 1) * n / count;
-                let need = range.len() * per + MARGIN;
-                let spare = free.split_off(free.len() - need.min(free.len()));
-                let fresh = slots..slots + need - spare.len();
-                slots = fresh.end;
-                Chunk::new(j, range, spare, fresh)
-            })
-            .collect();
-        for d in free {
-            self.tds.delete(d);
-        }
-        let dead = Cell::new([VertexId::NONE; N], [self.space.identity(); N]);
-        self.tds.cells.resize(slots, dead);
         // every live cell stamped with its owner: the chunk whose keys hold its vertex 0's
-        // (a point takes two marks: an inside and an outside one)
-        let shift = Ownership::shift_for(count, n.div_ceil(count), 2);
-        let own = Ownership {
+        // (a point takes two marks, an inside and an outside one, in each pass it is tried)
+        let shift = Ownership::shift_for(count, n.div_ceil(count), MARKS);
+        let mut own = Ownership {
             first: self.tds.reserve_stamps((count as u32) << shift),
             shift,
+            level: 0,
         };
         let bounds: Vec<u64> = (1..count).map(|j| wave[j * n / count].3).collect();
         let keys = &shared.keys;
@@ -605,9 +632,83 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                     c.set_stamp(own.stamp(bounds.partition_point(|&b| b <= key) as u32));
                 }
             });
+        let all: Vec<u32> = (0..n as u32).collect();
+        let groups = (0..count).map(|j| (j * n / count..(j + 1) * n / count, 0));
+        let (mut left, mut marks) =
+            self.run_chunks((wave, &all), groups, (own, STRIDE, base), outcome);
+        // the chunk of each position, and the level of the group that holds a point and
+        // the chunk whose cell stopped it (unknown: the next level)
+        let chunk_of = |s: u32| ((s as usize + 1) * count - 1) / n;
+        let need = |level: u32, s: u32, met: Option<u32>| {
+            met.map_or(level + 1, |o| {
+                u32::BITS - (chunk_of(s) as u32 ^ o).leading_zeros()
+            })
+            .max(level + 1)
+        };
+        let mut pending: Vec<(u32, u32)> = left.iter().map(|&(s, o)| (s, need(0, s, o))).collect();
+        for level in 1..count.trailing_zeros() {
+            own.level = level;
+            let mut active: Vec<u32> = Vec::new();
+            let mut groups = Vec::new();
+            for g in 0..count >> level {
+                let from = active.len();
+                active.extend(
+                    pending.iter().filter_map(|&(s, l)| {
+                        (l == level && chunk_of(s) >> level == g).then_some(s)
+                    }),
+                );
+                groups.push((from..active.len(), marks[g << level]));
+            }
+            if active.len() < GROUPED_FEWEST {
+                continue;
+            }
+            pending.retain(|&(_, l)| l != level);
+            let used;
+            (left, used) =
+                self.run_chunks((wave, &active), groups.into_iter(), (own, 1, base), outcome);
+            for (g, m) in used.into_iter().enumerate() {
+                marks[g << level] = m;
+            }
+            pending.extend(left.iter().map(|&(s, o)| (s, need(level, s, o))));
+        }
+    }
+
+    /// Runs the chunks `groups` (each its range in `active` and the visit marks it took
+    /// before) on the engine's threads, ownership by `own`, every `stride`-th point of a
+    /// chunk located before: writes the outcomes, and returns the points left (with the
+    /// chunk whose cell stopped each, if known) and the marks each chunk has taken.
+    fn run_chunks(
+        &mut self,
+        (wave, active): (&[Item<S::Point>], &[u32]),
+        groups: impl Iterator<Item = (Range<usize>, u32)>,
+        (own, stride, base): (Ownership, usize, usize),
+        outcome: &mut [Outcome],
+    ) -> (Vec<(u32, Option<u32>)>, Vec<u32>) {
+        // cell slots for each chunk: free ones, then new ones (a vertex makes `2` more
+        // triangles on a surface, some 6.8 more tetrahedra in a volume)
+        let per = if N == 3 { 2 } else { 8 };
+        let mut free = self.tds.take_free();
+        let mut slots = self.tds.cells.len();
+        let mut chunks: Vec<Chunk<S::Elem, N>> = groups
+            .enumerate()
+            .map(|(j, (range, marks))| {
+                let need = range.len() * per + MARGIN;
+                let spare = free.split_off(free.len() - need.min(free.len()));
+                let fresh = slots..slots + need - spare.len();
+                slots = fresh.end;
+                let mut ch = Chunk::new(j as u32, range, spare, fresh);
+                ch.marks = marks;
+                ch
+            })
+            .collect();
+        for d in free {
+            self.tds.delete(d);
+        }
+        let dead = Cell::new([VertexId::NONE; N], [self.space.identity(); N]);
+        self.tds.cells.resize(slots, dead);
         chunks
             .par_iter_mut()
-            .for_each(|ch| self.locate_starts(ch, wave, &own));
+            .for_each(|ch| self.locate_starts(ch, (wave, active), &own, stride));
         let cells = SharedCells {
             base: self.tds.cells.as_mut_ptr(),
             len: slots,
@@ -618,6 +719,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         // written only through it.
         let vcell: &[AtomicU32] =
             unsafe { std::slice::from_raw_parts(self.vcell.as_mut_ptr().cast(), vcell_len) };
+        let count = chunks.len();
         let threads = self.threads.clamp(1, count);
         let pass = Pass {
             engine: &*self,
@@ -625,6 +727,8 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             vcell,
             own,
             wave,
+            active,
+            stride,
             base,
             chunks: chunks.as_mut_ptr(),
             count,
@@ -640,22 +744,33 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 pass.work();
             });
         }
+        let mut left = Vec::new();
+        let mut marks = Vec::with_capacity(count);
         for ch in &mut chunks {
             for &(s, o) in &ch.outcomes {
                 outcome[s as usize] = o;
             }
+            left.append(&mut ch.left);
+            marks.push(ch.marks);
             for d in ch.leftover() {
                 self.tds.delete(d);
             }
         }
+        (left, marks)
     }
 
     /// Locates every [`STRIDE`]-th point of chunk `ch`, only reading, before the pass: its
     /// `starts`.
-    fn locate_starts(&self, ch: &mut Chunk<S::Elem, N>, wave: &[Item<S::Point>], own: &Ownership) {
+    fn locate_starts(
+        &self,
+        ch: &mut Chunk<S::Elem, N>,
+        (wave, active): (&[Item<S::Point>], &[u32]),
+        own: &Ownership,
+        stride: usize,
+    ) {
         let mut last = None;
-        let starts = ch.range.clone().step_by(STRIDE).map(|s| {
-            let (_, p, _, key) = wave[s];
+        let starts = ch.range.clone().step_by(stride).map(|t| {
+            let (_, p, _, key) = wave[active[t] as usize];
             let (c, shift) = self.jump(key).or(last).unwrap_or_else(|| self.start_cell());
             let (c, q) = self.walk((p, shift), c, &mut SplitMix::new(key));
             last = Some((c, q));
@@ -689,13 +804,23 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         vcell: &[AtomicU32],
     ) {
         let me = ch.id;
-        let owned = |c: CellId| self.owner_of(own, c) == me;
+        let met = std::cell::Cell::new(None);
+        let owned = |c: CellId| {
+            let s = self.tds.cells[c.index()].stamp();
+            let mine = own.owner(s) == me;
+            if !mine {
+                met.set(Some(own.chunk(s)));
+            }
+            mine
+        };
         ch.found = Found::Foreign;
+        ch.foreign = None;
         let Some((c, _, shift)) = ch.hint.filter(|&h| self.still_there(h)) else {
             return;
         };
         let mut rng = SplitMix::new(key);
         let Some((c0, q0)) = self.walk_within((p, shift), c, &mut rng, owned) else {
+            ch.foreign = met.get();
             return;
         };
         if let Some(v) = self.coincident_vertex(c0, (p, q0), 0.0) {
@@ -761,6 +886,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 continue;
             }
             if own.owner(st) != ch.id {
+                ch.foreign = Some(own.chunk(st));
                 return false;
             }
             let (a, b) = edge_ends(&cell.v, i, step);
@@ -819,6 +945,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 }
                 if st != outside {
                     if own.owner(st) != ch.id {
+                        ch.foreign = Some(own.chunk(st));
                         return false;
                     }
                     if let Some(qd) = self.conflict_across((c, i, d), (p, qo), 0.0) {
@@ -1032,7 +1159,11 @@ mod tests {
         let shift = Ownership::shift_for(8, 100, 2);
         assert_eq!(shift, 8, "201 stamps a chunk round up to 256");
         assert_eq!(Ownership::shift_for(8, 100, 5), 9, "501 round up to 512");
-        let own = Ownership { first: 1000, shift };
+        let own = Ownership {
+            first: 1000,
+            shift,
+            level: 0,
+        };
         for j in 0..8 {
             assert_eq!(own.owner(own.stamp(j)), j);
             let marks: Vec<u32> = (1..).map_while(|k| own.mark(j, k)).collect();
@@ -1046,6 +1177,21 @@ mod tests {
         // older stamps (visits before the pass) and stamps after the last chunk: no owner
         for s in [0, 1, 999, 1000 + (8 << shift), u32::MAX] {
             assert!(own.owner(s) >= 8, "stamp {s}");
+        }
+        // merged in groups of 2 and 4: a group owns its chunks' cells and marks, and its
+        // own stamps and marks are its first chunk's
+        for level in 1..3 {
+            let group = Ownership { level, ..own };
+            for j in 0..8 {
+                assert_eq!(group.owner(own.stamp(j)), j >> level);
+                assert_eq!(group.owner(own.mark(j, 5).unwrap()), j >> level);
+                assert_eq!(group.chunk(own.stamp(j)), j);
+            }
+            for g in 0..8 >> level {
+                assert_eq!(group.stamp(g), own.stamp(g << level));
+                assert_eq!(group.mark(g, 3), own.mark(g << level, 3));
+            }
+            assert!(group.owner(u32::MAX) >= 8 >> level);
         }
         // huge chunks: capped so that the 8 chunks' stamps fit
         assert!(8u64 << Ownership::shift_for(8, usize::MAX / 4, 64) <= 1 << 30);
