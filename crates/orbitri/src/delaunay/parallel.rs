@@ -8,7 +8,8 @@
 //! of the curve: a cell belongs to the chunk whose range holds the spatial key of its
 //! vertex 0, and a new cell to the chunk that made it. A chunk inserts its points one after
 //! another, as a sequential insertion would (each walk starts from its last insertion, or
-//! every 64th from a cell located before the pass), but only where it owns everything it
+//! every 64th, and in the group passes below every one, from a cell located before the
+//! pass), but only where it owns everything it
 //! reads or writes: the walk, the conflict region and the cells across its boundary. A
 //! point that needs another chunk's cell, or whose 3D star the ridge table refuses, is
 //! deferred. The chunks run on the threads in any order and at once, with no lock: a cell
@@ -65,8 +66,15 @@ const MARKS: usize = 16;
 /// The fewest points left on the chunks' borders that go in by groups of chunks: fewer go
 /// in one at a time, which costs less than setting up the groups (on a surface, where
 /// the borders are curves, they are 3 % of a wave of 10⁶ points, and grouping them made
-/// the sphere 5 % slower).
+/// the sphere 5 % slower). (The unit tests group every level of 64 or more, so that their
+/// builds of thousands of points take the group passes.)
+#[cfg(not(test))]
 const GROUPED_FEWEST: usize = 8192;
+#[cfg(test)]
+const GROUPED_FEWEST: usize = 64;
+// the groups halve the chunks down to two, and a chunk's marks hold two a point at each
+// level: `2·(1 + 2 + … + CHUNKS/2)`
+const _: () = assert!(CHUNKS.is_power_of_two() && MARKS >= 2 * (CHUNKS - 1));
 /// Cell slots reserved for a chunk beyond its points' share.
 const MARGIN: usize = 64;
 
@@ -129,7 +137,7 @@ enum Outcome {
     Alone,
 }
 
-/// A chunk of a pass: its points (`range`, positions in the wave), the cell slots it may
+/// A chunk of a pass: its points (`range`, indices into the pass's `active` positions), the cell slots it may
 /// fill, its last insertion, and what the probe found for its current point.
 #[derive(Debug)]
 struct Chunk<O, const N: usize> {
@@ -138,11 +146,11 @@ struct Chunk<O, const N: usize> {
     /// The cell of the chunk's last insertion, its vertices (a reused slot fails the check)
     /// and the shift that lifts a point near it into its frame.
     hint: Option<(CellId, [VertexId; N], O)>,
-    /// For every [`STRIDE`]-th point: the cell that held it before the pass, as `hint`,
+    /// For every `stride`-th point: the cell that held it before the pass, as `hint`,
     /// when the chunk owned it.
     starts: Vec<Option<(CellId, [VertexId; N], O)>>,
     found: Found,
-    /// Its cell slots ran out: its other points are deferred.
+    /// Its cell slots or visit marks ran out: its other points are deferred.
     full: bool,
     /// The region: cells with the point's offset in each one's frame, in search order.
     conflict: Vec<(CellId, O)>,
@@ -152,7 +160,9 @@ struct Chunk<O, const N: usize> {
     across: Vec<(CellId, u8)>,
     /// The visit marks taken so far from the chunk's stamps ([`Ownership::mark`]).
     marks: u32,
-    /// The chunk of the pass that owns the cell which stopped the current probe, if known.
+    /// The chunk of the pass whose stamps hold the stamp of the cell that stopped the
+    /// current probe, if known (its owner, or in a group pass possibly the first chunk of
+    /// the group that owns it and marked it meanwhile: the same group, see `need`).
     foreign: Option<u32>,
     /// The points it left: (position in the wave, `foreign` then).
     left: Vec<(u32, Option<u32>)>,
@@ -637,7 +647,11 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         let (mut left, mut marks) =
             self.run_chunks((wave, &all), groups, (own, STRIDE, base), outcome);
         // the chunk of each position, and the level of the group that holds a point and
-        // the chunk whose cell stopped it (unknown: the next level)
+        // the chunk whose cell stopped it (unknown: the next level). In a group pass of
+        // level `L` that chunk may read as the first chunk of the group owning the cell
+        // (which marked it meanwhile): both lie in that group, outside the point's, so
+        // the bit that sets the level (at or above `L`) is the same, and so is the result
+        // whatever the timing.
         let chunk_of = |s: u32| ((s as usize + 1) * count - 1) / n;
         let need = |level: u32, s: u32, met: Option<u32>| {
             met.map_or(level + 1, |o| {
@@ -648,6 +662,8 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         let mut pending: Vec<(u32, u32)> = left.iter().map(|&(s, o)| (s, need(0, s, o))).collect();
         for level in 1..count.trailing_zeros() {
             own.level = level;
+            // (in curve order within each group)
+            pending.sort_unstable();
             let mut active: Vec<u32> = Vec::new();
             let mut groups = Vec::new();
             for g in 0..count >> level {
@@ -684,6 +700,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         (own, stride, base): (Ownership, usize, usize),
         outcome: &mut [Outcome],
     ) -> (Vec<(u32, Option<u32>)>, Vec<u32>) {
+        debug_assert!(stride.is_power_of_two());
         // cell slots for each chunk: free ones, then new ones (a vertex makes `2` more
         // triangles on a surface, some 6.8 more tetrahedra in a volume)
         let per = if N == 3 { 2 } else { 8 };
@@ -759,7 +776,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         (left, marks)
     }
 
-    /// Locates every [`STRIDE`]-th point of chunk `ch`, only reading, before the pass: its
+    /// Locates every `stride`-th point of chunk `ch`, only reading, before the pass: its
     /// `starts`.
     fn locate_starts(
         &self,
@@ -1152,6 +1169,42 @@ mod tests {
         e.end_batch();
         assert!(e.wave_keys.is_empty());
         assert!(e.is_valid().is_ok());
+    }
+
+    /// The group passes (every level of 64 or more points here) keep the result: every
+    /// thread count stores the same valid triangulation, slot for slot, with the cells of
+    /// one at a time.
+    #[test]
+    fn the_border_points_go_in_by_groups_the_same_on_any_thread_count() {
+        let mut r = SplitMix::new(11);
+        let mut items: Vec<super::Item<[f64; 3]>> = (0..30_000u32)
+            .map(|k| (k, [r.unit(), r.unit(), r.unit()], 0.0, 0))
+            .collect();
+        let space = FlatTorus3::cuboid([1.0; 3]).unwrap();
+        for it in &mut items {
+            it.3 = space.spatial_key(&it.1);
+        }
+        items.sort_by_key(|it| it.3);
+        let build = |threads: Option<usize>| {
+            let mut e = Engine::new(space.clone());
+            e.set_threads(threads);
+            let (log, flow) = e.insert_parallel(&items, |_| std::ops::ControlFlow::Continue(()));
+            assert!(flow.is_continue());
+            assert_eq!(log.events.len(), items.len());
+            e.end_batch();
+            assert!(e.is_valid().is_ok(), "{threads:?} threads");
+            e
+        };
+        let alone = build(None);
+        let one = build(Some(1));
+        assert_eq!(one.points.len(), 30_000);
+        assert_eq!(one.tds.len(), alone.tds.len());
+        for threads in [2, 3] {
+            assert!(
+                build(Some(threads)).tds.cells == one.tds.cells,
+                "{threads} threads"
+            );
+        }
     }
 
     #[test]
