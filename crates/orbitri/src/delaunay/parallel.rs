@@ -9,8 +9,8 @@
 //! vertex 0, and a new cell to the chunk that made it. A chunk inserts its points one after
 //! another, as a sequential insertion would (each walk starts from its last insertion, or
 //! every 64th, and in the group passes below every one, from a cell located before the
-//! pass), but only where it owns everything it
-//! reads or writes: the walk, the conflict region and the cells across its boundary. A
+//! pass), but only where it owns everything it reads or writes: the walk, the conflict
+//! region and the cells across its boundary. A
 //! point that needs another chunk's cell, or whose 3D star the ridge table refuses, is
 //! deferred. The chunks run on the threads in any order and at once, with no lock: a cell
 //! next to a chunk's own cell cannot change while it is, since changing it would write the
@@ -137,8 +137,9 @@ enum Outcome {
     Alone,
 }
 
-/// A chunk of a pass: its points (`range`, indices into the pass's `active` positions), the cell slots it may
-/// fill, its last insertion, and what the probe found for its current point.
+/// A chunk of a pass: its points (`range`, indices into the pass's `active` positions),
+/// the cell slots it may fill, its last insertion, and what the probe found for its
+/// current point.
 #[derive(Debug)]
 struct Chunk<O, const N: usize> {
     id: u32,
@@ -823,7 +824,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         let me = ch.id;
         let met = std::cell::Cell::new(None);
         let owned = |c: CellId| {
-            let s = self.tds.cells[c.index()].stamp();
+            let s = self.tds.stamp(c);
             let mine = own.owner(s) == me;
             if !mine {
                 met.set(Some(own.chunk(s)));
