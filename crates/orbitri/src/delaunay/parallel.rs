@@ -723,7 +723,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             self.tds.delete(d);
         }
         let dead = Cell::new([VertexId::NONE; N], [self.space.identity(); N]);
-        self.tds.cells.resize(slots, dead);
+        self.tds.grow(slots, dead);
         chunks
             .par_iter_mut()
             .for_each(|ch| self.locate_starts(ch, (wave, active), &own, stride));
