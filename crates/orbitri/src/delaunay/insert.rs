@@ -85,12 +85,15 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// the facets in a random rotation drawn from `rng` (the walk's only state: the
     /// triangulation is only read).
     pub fn walk(&self, q: LiftedOf<S, N>, start: CellId, rng: &mut SplitMix) -> (CellId, S::Elem) {
-        self.walk_within(q, start, rng, |_| true)
-            .expect("a walk through every cell ends in one")
+        let (c, qo, _) = self
+            .walk_within(q, start, rng, |_| true)
+            .expect("a walk through every cell ends in one");
+        (c, qo)
     }
 
     /// [`Self::walk`] through the cells that `inside` accepts (`start` among them): `None`
-    /// when it would step into another.
+    /// when it would step into another. The flag is true when the point is strictly inside
+    /// the cell found (on none of its facets' planes).
     #[inline(always)]
     pub(super) fn walk_within(
         &self,
@@ -98,7 +101,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         start: CellId,
         rng: &mut SplitMix,
         inside: impl Fn(CellId) -> bool,
-    ) -> Option<(CellId, S::Elem)> {
+    ) -> Option<(CellId, S::Elem, bool)> {
         let (p, mut qo) = q;
         let mut c = start;
         let mut prev = CellId::NONE;
@@ -106,6 +109,8 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             let r = rng.below(N);
             self.tds.prefetch_neighbours(c);
             let (mut pts, mut offs) = self.stored_cell(c);
+            // (the facet just crossed has the point strictly on this cell's side)
+            let mut strict = true;
             for k in 0..N {
                 let i = (r + k) % N;
                 let d = self.tds.cells[c.index()].n[i];
@@ -126,15 +131,19 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                     c = d;
                     continue 'walk;
                 }
+                strict &= o == Sign::Positive;
             }
-            return Some((c, qo));
+            return Some((c, qo, strict));
         }
     }
 
     /// [`Self::walk`] with the engine's own random generator (insertion).
-    fn locate_from(&mut self, q: LiftedOf<S, N>, start: CellId) -> (CellId, S::Elem) {
+    /// (The flag: strictly inside, as [`Self::walk_within`].)
+    fn locate_from(&mut self, q: LiftedOf<S, N>, start: CellId) -> (CellId, S::Elem, bool) {
         let mut rng = self.rng.clone();
-        let found = self.walk(q, start, &mut rng);
+        let found = self
+            .walk_within(q, start, &mut rng, |_| true)
+            .expect("a walk through every cell ends in one");
         self.rng = rng;
         found
     }
@@ -274,8 +283,8 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     }
 
     /// Replaces the conflict region by the cone from the new vertex `x` (lifted with offset
-    /// `qoff` as inserted) over its boundary. (Like [`Self::conflict_region`], never
-    /// inlined: kept apart, the two run 4 % faster on the sphere.)
+    /// `qoff` as inserted) over its boundary (never inlined: see
+    /// [`Self::conflict_region_at`]).
     #[inline(never)]
     pub(super) fn star_hole(&mut self, x: VertexId, qoff: S::Elem) {
         let mut scratch = std::mem::take(&mut self.scratch);
@@ -545,7 +554,8 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
 
     /// Inserts the lifted point `q` of point `point` as vertex `x`, or says why not.
     /// The walk starts at `from` (a cell and the shift that lifts `q` into its frame) or,
-    /// without it, from the last insertion.
+    /// without it, from the last insertion. Strictly inside a triangle where
+    /// [`Self::flips`], by splitting it and flipping; else by starring the conflict region.
     pub(crate) fn insert_lifted(
         &mut self,
         q: LiftedOf<S, N>,
@@ -553,14 +563,31 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         check_duplicate: bool,
         from: Option<(CellId, S::Elem)>,
     ) -> Result<(), Refused> {
-        self.conflict_region(q, x, check_duplicate, from)?;
+        let (c, qo, strict) = self.locate_lifted(q, from);
+        if strict && self.flips() {
+            // (strictly inside a triangle: no vertex there, no duplicate)
+            self.split_and_flip(c, (q.0, qo), x, q.1);
+            return Ok(());
+        }
+        self.conflict_region_at((c, qo), q, x, check_duplicate)?;
         self.star_hole(x, q.1);
         Ok(())
     }
 
-    /// The first half of [`Self::insert_lifted`]: locates `q` and collects its conflict
-    /// region (in the scratch), or says why it would not be inserted.
-    #[inline(never)]
+    /// The cell containing the lifted point `q`, found from `from` (or the last insertion),
+    /// `q`'s element in its frame, and whether `q` is strictly inside it.
+    #[inline(always)]
+    fn locate_lifted(
+        &mut self,
+        q: LiftedOf<S, N>,
+        from: Option<(CellId, S::Elem)>,
+    ) -> (CellId, S::Elem, bool) {
+        let (start, shift) = from.unwrap_or_else(|| self.start_cell());
+        self.locate_from((q.0, self.space.compose(shift, q.1)), start)
+    }
+
+    /// Locates `q` and collects its conflict region (in the scratch), or says why it would
+    /// not be inserted: the first half of an insertion that stars the region.
     pub(super) fn conflict_region(
         &mut self,
         q: LiftedOf<S, N>,
@@ -568,8 +595,20 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         check_duplicate: bool,
         from: Option<(CellId, S::Elem)>,
     ) -> Result<(), Refused> {
-        let (start, shift) = from.unwrap_or_else(|| self.start_cell());
-        let (c, qo) = self.locate_from((q.0, self.space.compose(shift, q.1)), start);
+        let (c, qo, _) = self.locate_lifted(q, from);
+        self.conflict_region_at((c, qo), q, x, check_duplicate)
+    }
+
+    /// [`Self::conflict_region`] once `q` is located: in cell `c`, lifted by `qo`. (Like
+    /// [`Self::star_hole`], never inlined: kept apart, the two run 4 % faster on the sphere.)
+    #[inline(never)]
+    fn conflict_region_at(
+        &mut self,
+        (c, qo): (CellId, S::Elem),
+        q: LiftedOf<S, N>,
+        x: VertexId,
+        check_duplicate: bool,
+    ) -> Result<(), Refused> {
         let wq = self.vertex_weight(x);
         if check_duplicate {
             if let Some(v) = self.coincident_vertex(c, (q.0, qo), wq) {

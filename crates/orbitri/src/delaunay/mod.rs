@@ -7,6 +7,7 @@
 //! serves every level.
 
 mod covering;
+mod flip;
 mod insert;
 mod locator;
 mod parallel;

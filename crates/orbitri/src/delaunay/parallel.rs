@@ -590,12 +590,20 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             // (along the borders the next point may be far: from the grid when it is)
             let from = self.insertion_start(key);
             let x = VertexId::new(base + s);
-            outcome[s] = match self.conflict_region((p, self.space.identity()), x, true, from) {
-                Ok(()) if self.hides() && self.scratch_hides() => Outcome::Alone,
-                Ok(()) => {
-                    self.star_hole(x, self.space.identity());
+            let q = (p, self.space.identity());
+            let placed = if self.hides() {
+                self.conflict_region(q, x, true, from).map(|()| {
+                    if self.scratch_hides() {
+                        return Outcome::Alone;
+                    }
+                    self.star_hole(x, q.1);
                     Outcome::New
-                }
+                })
+            } else {
+                self.insert_lifted(q, x, true, from).map(|()| Outcome::New)
+            };
+            outcome[s] = match placed {
+                Ok(outcome) => outcome,
                 Err(Refused::Duplicate(v)) => Outcome::Duplicate(self.vpoint[v.index()]),
                 Err(Refused::Hidden) => Outcome::Hidden,
                 Err(Refused::NotSimplicial) => unreachable!("the criterion holds"),
@@ -837,7 +845,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             return;
         };
         let mut rng = SplitMix::new(key);
-        let Some((c0, q0)) = self.walk_within((p, shift), c, &mut rng, owned) else {
+        let Some((c0, q0, _)) = self.walk_within((p, shift), c, &mut rng, owned) else {
             ch.foreign = met.get();
             return;
         };
