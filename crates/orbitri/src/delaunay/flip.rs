@@ -37,26 +37,33 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         qoff: S::Elem,
     ) {
         let old = self.tds.cells[c.index()];
-        let [v0, v1, v2] = [0, 1, 2].map(|k| old.v[k]);
-        let [o0, o1, o2] = [0, 1, 2].map(|k| old.off[k]);
-        // `x` in place of each vertex in turn, rotated to slot 0 (the first in `c`'s slot),
-        // each linked to the neighbour across its edge and to the other two
-        let b = self.make_cell(tri([x, v2, v0]), tri([qo, o2, o0]));
-        let d = self.make_cell(tri([x, v0, v1]), tri([qo, o0, o1]));
-        self.rewrite(c, [x, v1, v2], [qo, o1, o2], [old.n[0], b, d]);
-        self.tds.cells[b.index()].n = tri([old.n[1], d, c]);
-        self.tds.cells[d.index()].n = tri([old.n[2], c, b]);
+        // (two more slots; guaranteed, so no criterion bookkeeping)
+        let (b, d) = (self.tds.create(old), self.tds.create(old));
+        for (id, t) in [c, b, d].into_iter().zip(split(&old, x, qo, [c, b, d])) {
+            self.rewrite(id, t);
+        }
         self.relink(b, 0, old.n[1], c);
         self.relink(d, 0, old.n[2], c);
-        self.vcell[v0.index()] = b;
+        self.vcell[old.v[0].index()] = b;
         // (the cells whose edge opposite `x` is still to test)
         let mut edges = std::mem::take(&mut self.scratch.created);
         edges.clear();
         edges.extend([c, b, d]);
         while let Some(t) = edges.pop() {
-            if let Some(across) = self.flip(t, p) {
-                edges.extend([t, across]);
-            }
+            let tc = self.tds.cells[t.index()];
+            let e = tc.n[0];
+            let Some((far, j)) = self.far_in_conflict(t, &tc, e, p) else {
+                continue;
+            };
+            let ec = self.tds.cells[e.index()];
+            let ([nt, ne], [(first, o1), (second, o2)]) = flipped(&tc, (e, &ec, j), far, t);
+            self.rewrite(t, nt);
+            self.rewrite(e, ne);
+            self.relink(t, 0, o1, e);
+            self.relink(e, 1, o2, t);
+            self.vcell[first.index()] = t;
+            self.vcell[second.index()] = e;
+            edges.extend([t, e]);
         }
         self.scratch.created = edges;
         self.vcell[x.index()] = c;
@@ -64,54 +71,43 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.hint_shift = self.space.carry(qoff, self.tds.cells[c.index()].off[0]);
     }
 
-    /// Flips the edge opposite the new vertex (point `p`, slot 0 of cell `t`) when the
-    /// triangle across it is in conflict with the point: `t` becomes the triangle of the
-    /// new vertex, the edge's first end and the far vertex, the cell across the one of the
-    /// new vertex, the far vertex and the edge's second end (the new vertex at slot 0 of
-    /// both). Returns the cell across, or `None` when nothing was flipped.
+    /// The element, in the frame of cell `t` (contents `tc`, the new vertex at slot 0), of
+    /// the vertex of its neighbour `e` across from the new vertex, and that vertex's slot,
+    /// when `e` is in conflict with the new point `p`: the edge between them is to flip.
     #[inline(always)]
-    fn flip(&mut self, t: CellId, p: S::Point) -> Option<CellId> {
-        let s = 0;
-        let tc = self.tds.cells[t.index()];
-        let e = tc.n[s];
+    fn far_in_conflict(
+        &self,
+        t: CellId,
+        tc: &Cell<S::Elem, N>,
+        e: CellId,
+        p: S::Point,
+    ) -> Option<(S::Elem, usize)> {
         // the new vertex's element in `e`'s frame, and back
-        let to_e = self.translation(t, s, e);
-        if !self.cell_conflicts(e, (p, self.space.relative(tc.off[s], to_e)), 0.0) {
+        let to_e = self.translation(t, 0, e);
+        if !self.cell_conflicts(e, (p, self.space.relative(tc.off[0], to_e)), 0.0) {
             return None;
         }
-        let ec = self.tds.cells[e.index()];
-        let j = self.mirror_of(e, t);
-        // `e` is (far, second end, first end) from slot `j`, as `t` is oriented alike
-        let (s1, s2, j1, j2) = ((s + 1) % 3, (s + 2) % 3, (j + 1) % 3, (j + 2) % 3);
-        let (first, second, far) = (tc.v[s1], tc.v[s2], ec.v[j]);
-        let far_off = self.space.compose(to_e, ec.off[j]);
-        self.rewrite(
-            t,
-            [tc.v[s], first, far],
-            [tc.off[s], tc.off[s1], far_off],
-            [ec.n[j1], e, tc.n[s2]],
-        );
-        self.rewrite(
-            e,
-            [tc.v[s], far, second],
-            [tc.off[s], far_off, tc.off[s2]],
-            [ec.n[j2], tc.n[s1], t],
-        );
-        self.relink(t, 0, ec.n[j1], e);
-        self.relink(e, 1, tc.n[s1], t);
-        self.vcell[first.index()] = t;
-        self.vcell[second.index()] = e;
-        Some(e)
+        let ec = &self.tds.cells[e.index()];
+        let j = ec.mirror(t).expect("symmetric neighbours");
+        Some((self.space.compose(to_e, ec.off[j]), j))
     }
 
-    /// Overwrites live cell `c` (keeping its stamp) with vertices `v`, elements `off`
-    /// (canonicalized: in an orientable space, no slot moves) and neighbours `n` (2D).
+    /// A triangle in canonical form (see [`Self::canonicalize`]: in an orientable space, no
+    /// slot moves), as a cell.
     #[inline(always)]
-    fn rewrite(&mut self, c: CellId, v: [VertexId; 3], off: [S::Elem; 3], n: [CellId; 3]) {
+    fn canonical_triangle(&self, (v, off, n): Triangle<S::Elem>) -> Cell<S::Elem, N> {
         let mut cell = Cell::new(tri(v), tri(off));
         self.canonicalize(&mut cell);
+        cell.n = tri(n);
+        cell
+    }
+
+    /// Overwrites live cell `c` with triangle `t` (canonical; the stamp kept).
+    #[inline(always)]
+    fn rewrite(&mut self, c: CellId, t: Triangle<S::Elem>) {
+        let cell = self.canonical_triangle(t);
         let slot = &mut self.tds.cells[c.index()];
-        (slot.v, slot.off, slot.n) = (cell.v, cell.off, tri(n));
+        (slot.v, slot.off, slot.n) = (cell.v, cell.off, cell.n);
     }
 
     /// Links facet `i` of `a` with the facet of `d` that was linked to `old`.
@@ -120,6 +116,57 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         let j = self.mirror_of(d, old);
         self.link(a, i, d, j);
     }
+}
+
+/// A triangle as the flips build it: vertices, elements, neighbours.
+type Triangle<O> = ([VertexId; 3], [O; 3], [CellId; 3]);
+
+/// The triangles that splitting cell `old` at vertex `x` (element `qo`) makes, for the
+/// slots `[c, b, d]` (`c` is `old`'s): `x` in place of each vertex in turn, rotated to
+/// slot 0, each linked to the neighbour across its edge and to the other two.
+fn split<O: Copy, const N: usize>(
+    old: &Cell<O, N>,
+    x: VertexId,
+    qo: O,
+    [c, b, d]: [CellId; 3],
+) -> [Triangle<O>; 3] {
+    let ([v0, v1, v2], [o0, o1, o2], [n0, n1, n2]) = (
+        [0, 1, 2].map(|k| old.v[k]),
+        [0, 1, 2].map(|k| old.off[k]),
+        [0, 1, 2].map(|k| old.n[k]),
+    );
+    [
+        ([x, v1, v2], [qo, o1, o2], [n0, b, d]),
+        ([x, v2, v0], [qo, o2, o0], [n1, d, c]),
+        ([x, v0, v1], [qo, o0, o1], [n2, c, b]),
+    ]
+}
+
+/// Flips the edge opposite the new vertex (slot 0 of cell `t`, contents `tc`) with the
+/// neighbour `e` across it (contents `ec`, `t` at its slot `j`; its far vertex at element
+/// `far` in `t`'s frame): `t` becomes the triangle of the new vertex, the edge's first end
+/// and the far vertex, `e` the one of the new vertex, the far vertex and the edge's second
+/// end (the new vertex at slot 0 of both). Also returns the edge's first end, which
+/// left `e`, with the outside cell now across from the new vertex in `t` (it was linked to
+/// `e`), and the second end, which left `t`, with the outside cell now at slot 1 of `e`
+/// (it was linked to `t`).
+fn flipped<O: Copy, const N: usize>(
+    tc: &Cell<O, N>,
+    (e, ec, j): (CellId, &Cell<O, N>, usize),
+    far: O,
+    t: CellId,
+) -> ([Triangle<O>; 2], [(VertexId, CellId); 2]) {
+    // `e` is (far, second end, first end) from slot `j`, as `t` is oriented alike
+    let (j1, j2) = ((j + 1) % 3, (j + 2) % 3);
+    let (x, first, second, fv) = (tc.v[0], tc.v[1], tc.v[2], ec.v[j]);
+    let (ox, o1, o2) = (tc.off[0], tc.off[1], tc.off[2]);
+    (
+        [
+            ([x, first, fv], [ox, o1, far], [ec.n[j1], e, tc.n[2]]),
+            ([x, fv, second], [ox, far, o2], [ec.n[j2], tc.n[1], t]),
+        ],
+        [(first, ec.n[j1]), (second, tc.n[1])],
+    )
 }
 
 /// A triangle's three entries as the engine's `N` slots (`N` is 3 wherever it flips).
