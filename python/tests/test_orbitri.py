@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import orbitri
+from simplices import canonical
 
 import freud  # noqa: E402  (a test dependency: pip install .[test])
 
@@ -245,15 +246,6 @@ def test_errors_are_value_errors_with_the_place():
         tri.insert([[0.1, 0.2, 0.3]])
 
 
-def _canonical(simplices, offsets):
-    out = set()
-    for v, o in zip(simplices.tolist(), offsets.tolist()):
-        pairs = sorted(zip(v, map(tuple, o)))
-        m = np.min([p[1] for p in pairs], axis=0)
-        out.add(tuple((a, tuple(np.subtract(b, m).tolist())) for a, b in pairs))
-    return out
-
-
 def _cli():
     exe = os.environ.get("ORBITRI_BIN")
     if exe:
@@ -279,8 +271,8 @@ def test_round_trip_equals_the_command_line(tmp_path):
         n = dim + 1
         tri = orbitri.PeriodicDelaunay(pts, [float(b) for b in box])
         assert (sheets, v, c) == (tri.sheets, 800, len(tri.simplices))
-        cli = _canonical(rows[:, :n], rows[:, n:].reshape(-1, n, dim))
-        assert cli == _canonical(tri.simplices, tri.offsets)
+        cli = canonical(rows[:, :n], rows[:, n:].reshape(-1, n, dim))
+        assert cli == canonical(tri.simplices, tri.offsets)
 
 
 def test_every_thread_count_gives_the_same_arrays():
@@ -303,8 +295,8 @@ def test_every_thread_count_gives_the_same_arrays():
             for a, b in zip(one, build(threads)):
                 assert np.array_equal(a, b)
     # one at a time (the default): the same simplices, stored in another order
-    canonical = lambda s: sorted(map(tuple, np.sort(s, axis=1)))
-    assert canonical(orbitri.SphericalDelaunay(sph).simplices) == canonical(sphere(2)[0])
+    faces = lambda s: sorted(map(tuple, np.sort(s, axis=1)))
+    assert faces(orbitri.SphericalDelaunay(sph).simplices) == faces(sphere(2)[0])
     for bad in (0, 10**6):
         with pytest.raises(ValueError, match="threads must be at least 1 and at most 1024"):
             orbitri.PeriodicDelaunay(pts3, [1.0, 1.0, 1.0], threads=bad)

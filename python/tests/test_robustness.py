@@ -11,14 +11,7 @@ import pytest
 import orbitri
 
 import freud  # noqa: E402  (a test dependency: pip install .[test])
-
-
-def _canonical(simplices, offsets):
-    """The simplices as a set, each a sorted tuple of (vertex, *offset) translated to a
-    componentwise minimum offset of zero."""
-    o = offsets - offsets.min(axis=1, keepdims=True)
-    rows = np.concatenate([simplices[:, :, None], o], axis=2).tolist()
-    return {tuple(sorted(map(tuple, r))) for r in rows}
+from simplices import canonical  # noqa: E402
 
 
 def _check_fills_the_box(tri):
@@ -49,7 +42,7 @@ def test_freud_2d_points_have_a_zero_third_column():
     ):
         tri = orbitri.PeriodicDelaunay(xyz, box)
         assert tri.dimension == 2 and tri.points.shape == (300, 2)
-        assert _canonical(tri.simplices, tri.offsets) == _canonical(want.simplices, want.offsets)
+        assert canonical(tri.simplices, tri.offsets) == canonical(want.simplices, want.offsets)
     # tilted: a 2 × 2 matrix, or freud's box with xy (freud's tilt: b = (xy·Ly, Ly))
     for box in (tilted, freud.box.Box(1.5, 1.0, xy=0.25, is2D=True)):
         vor = orbitri.periodic_voronoi(xyz, box)
@@ -128,7 +121,7 @@ def test_one_triangulation_shared_by_threads():
     _check_fills_the_box(tri)
     # the same triangulation as the bulk build of the points in their input order
     bulk = orbitri.PeriodicDelaunay(tri.points, [1.0, 1.0, 1.0])
-    assert _canonical(tri.simplices, tri.offsets) == _canonical(bulk.simplices, bulk.offsets)
+    assert canonical(tri.simplices, tri.offsets) == canonical(bulk.simplices, bulk.offsets)
 
 
 # --- insert is all or nothing ---------------------------------------------------------
@@ -137,14 +130,14 @@ def test_one_triangulation_shared_by_threads():
 def test_insert_checks_every_point_before_inserting_any():
     rng = np.random.default_rng(11)
     tri = orbitri.PeriodicDelaunay(rng.random((20, 2)), [1.0, 1.0])
-    cells = _canonical(tri.simplices, tri.offsets)
+    cells = canonical(tri.simplices, tri.offsets)
     # the error names the row of the batch (not the input id it would have had: 22)
     with pytest.raises(ValueError, match=r"^point 2: coordinate 1 is NaN, not a finite number$"):
         tri.insert([[0.1, 0.2], [0.3, 0.4], [0.5, np.nan]])
     with pytest.raises(ValueError, match=r"^point 1: coordinate 0 is -inf"):
         tri.insert(np.array([[0.1, 0.2], [-np.inf, 0.4]]))
     assert tri.number_of_input_points == 20 and len(tri.points) == 20
-    assert _canonical(tri.simplices, tri.offsets) == cells
+    assert canonical(tri.simplices, tri.offsets) == cells
     assert tri.insert([[0.1, 0.2], [0.3, 0.4]]).tolist() == [20, 21]
 
 
@@ -186,7 +179,7 @@ def test_try_one_sheet_brings_clustered_batches_to_the_bulk_result():
     assert tri.sheets == 4 and not tri.is_one_sheeted
     _check_fills_the_box(tri)
     # the covering's simplices, one per orbit, are the torus's Delaunay triangulation
-    assert _canonical(tri.simplices, tri.offsets) == _canonical(bulk.simplices, bulk.offsets)
+    assert canonical(tri.simplices, tri.offsets) == canonical(bulk.simplices, bulk.offsets)
     assert tri.try_one_sheet() is True
     assert tri.sheets == 1 and tri.is_one_sheeted
     _check_fills_the_box(tri)
@@ -194,7 +187,7 @@ def test_try_one_sheet_brings_clustered_batches_to_the_bulk_result():
     # position: it is unique), with the same input ids
     np.testing.assert_array_equal(tri.points, bulk.points)
     assert len(tri.simplices) == len(bulk.simplices)
-    assert _canonical(tri.simplices, tri.offsets) == _canonical(bulk.simplices, bulk.offsets)
+    assert canonical(tri.simplices, tri.offsets) == canonical(bulk.simplices, bulk.offsets)
     # and it stays correct after more insertions
     tri.insert(rng.random((30, 2)))
     _check_fills_the_box(tri)
@@ -292,11 +285,11 @@ def test_voronoi_of_nearly_coincident_points_is_finite_and_sums():
 def test_insert_of_a_point_out_of_reach_is_a_value_error_and_changes_nothing():
     box = np.array([[1.0, 0.0, 0.0], [0.3, 0.9, 0.0], [-0.2, 0.2, 1.1]])
     tri = orbitri.PeriodicDelaunay(np.random.default_rng(2).random((50, 3)), box)
-    cells = _canonical(tri.simplices, tri.offsets)
+    cells = canonical(tri.simplices, tri.offsets)
     with pytest.raises(ValueError, match=r"^point 1: .* too far from the domain"):
         tri.insert([[0.5, 0.5, 0.5], [1e300, 0.0, 0.0]])
     assert tri.number_of_input_points == 50
-    assert _canonical(tri.simplices, tri.offsets) == cells
+    assert canonical(tri.simplices, tri.offsets) == cells
 
 
 @pytest.fixture

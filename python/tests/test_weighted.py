@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 import orbitri
+from simplices import canonical
 
 pv = pytest.importorskip("pyvoro2")
 
@@ -58,7 +59,9 @@ def test_radii_are_square_roots_of_weights():
     # equal weights: the Delaunay triangulation
     c = orbitri.PeriodicDelaunay(points, [1.0, 1.0], weights=np.full(400, 0.3))
     d = orbitri.PeriodicDelaunay(points, [1.0, 1.0])
-    np.testing.assert_array_equal(c.simplices, d.simplices)
+    # (the same triangles; the weighted build stars each conflict region, the other splits
+    # and flips, so their cells come in other orders)
+    assert canonical(c.simplices, c.offsets) == canonical(d.simplices, d.offsets)
     assert c.hidden.size == 0
 
 
