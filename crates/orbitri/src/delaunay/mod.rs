@@ -41,7 +41,8 @@ struct Scratch<O> {
     conflict: Vec<(CellId, O)>,
     /// Boundary facets: (index into `conflict`, facet).
     boundary: Vec<(u32, u8)>,
-    /// New cells, parallel to `boundary`.
+    /// New cells, parallel to `boundary` (2D flips: the cells whose edge opposite the new
+    /// vertex is still to test).
     created: Vec<CellId>,
     /// Weighted: the vertices an insertion hid (those of conflict cells on no boundary
     /// facet), accumulated over the copies of a point.
