@@ -474,9 +474,6 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     /// How many points ahead of the insertion their data are loaded.
     const AHEAD: usize = 8;
 
-    /// How many points are gathered at a time.
-    const BLOCK: usize = 256;
-
     /// [`Self::insert_ordered`] of one round, `(spatial key, index)` pairs in insertion
     /// order, after `done` points. One at a time unless the engine has threads: the
     /// parallel insertion's items and log cost 56 bytes a point more at the peak (435 →
@@ -491,26 +488,23 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     ) -> Result<bool> {
         let weight = |k: usize| weights.get(k).copied().unwrap_or(0.0);
         if self.engine.threads().is_none() {
-            let mut block: Vec<[f64; D]> = Vec::with_capacity(Self::BLOCK);
-            for (b, part) in round.chunks(Self::BLOCK).enumerate() {
-                block.clear();
-                block.extend(part.iter().map(|&(_, k)| points[k as usize]));
-                for (m, (&(key, k), &p)) in part.iter().zip(&block).enumerate() {
-                    let n = b * Self::BLOCK + m;
-                    if (done + n) % 4096 == 0 {
-                        proceed(progress, done + n)?;
-                    }
-                    if let Some(&(_, ahead)) = round.get(n + Self::AHEAD) {
-                        self.prefetch_input(first + ahead as usize);
-                    }
-                    let k = k as usize;
-                    let w = weight(k);
-                    let r = self.engine.insert_keyed(p, w, key);
-                    if !keep(r, &self.engine.hidden_log) {
-                        return Ok(false);
-                    }
-                    self.record(InputId::new(first + k), p, w, r);
+            for (n, &(key, k)) in round.iter().enumerate() {
+                if (done + n) % 4096 == 0 {
+                    proceed(progress, done + n)?;
                 }
+                // (the points come in a random order: each point, and its entry in the
+                // input table that `record` writes, loaded ahead)
+                if let Some(&(_, ahead)) = round.get(n + Self::AHEAD) {
+                    crate::tds::prefetch(&points[ahead as usize]);
+                    self.prefetch_input(first + ahead as usize);
+                }
+                let k = k as usize;
+                let (p, w) = (points[k], weight(k));
+                let r = self.engine.insert_keyed(p, w, key);
+                if !keep(r, &self.engine.hidden_log) {
+                    return Ok(false);
+                }
+                self.record(InputId::new(first + k), p, w, r);
             }
             return Ok(true);
         }
