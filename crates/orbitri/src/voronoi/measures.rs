@@ -48,6 +48,19 @@ impl<const D: usize, E> Pieces<D, E> {
         }
     }
 
+    /// Starts loading where the pairs of point `far` are listed, and the first of the
+    /// pairs of point `near` (whose place was asked for some points before).
+    pub(super) fn prefetch(&self, far: Option<PointId>, near: Option<PointId>) {
+        if let Some(at) = far.and_then(|p| self.at.get(p.index())) {
+            prefetch(at);
+        }
+        if let Some(&(b, from, to)) = near.and_then(|p| self.at.get(p.index())) {
+            if from < to {
+                prefetch(&self.blocks[b as usize][from as usize]);
+            }
+        }
+    }
+
     /// The number of pairs.
     pub(super) fn number_of_pairs(&self) -> usize {
         self.blocks.iter().map(Vec::len).sum()

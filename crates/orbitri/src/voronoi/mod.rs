@@ -390,7 +390,16 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             all.reserve_exact(
                 pieces.number_of_pairs() + whole.iter().map(|w| w.1.len()).sum::<usize>(),
             );
-            for &(_, p) in order.iter().filter(|o| o.1 != PointId::NONE) {
+            for (k, &(_, p)) in order.iter().enumerate() {
+                if p == PointId::NONE {
+                    continue;
+                }
+                // (the lists lie at random: their places asked for 16 points ahead, the
+                // lists themselves 4 ahead, halve the time)
+                pieces.prefetch(
+                    order.get(k + 16).map(|o| o.1),
+                    order.get(k + 4).map(|o| o.1),
+                );
                 all.extend_from_slice(pieces.pairs_of(p));
                 // (`whole` is in point order, as the filter above found them)
                 if let Ok(k) = whole.binary_search_by_key(&p, |w| w.0) {
