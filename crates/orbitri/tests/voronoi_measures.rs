@@ -176,3 +176,39 @@ fn grids_by_pieces_equal_the_cells() {
     same_measures(&tri, 1.0, "square grid");
     assert!(tri.voronoi_measures().iter().all(|m| m.faces == 4));
 }
+
+/// After removals (which leave dead cell slots among the live ones), the measures are those
+/// of a fresh build of the points that stay, point for point.
+#[test]
+fn measures_after_removals_equal_a_fresh_build() {
+    let space = FlatTorus::cuboid([1.0; 3]).unwrap();
+    let pts = random(3000, 4, [1.0; 3]);
+    let mut tri = PeriodicDelaunay3::build(space.clone(), &pts).unwrap();
+    for i in (0..pts.len()).step_by(3) {
+        tri.remove(orbitri::InputId(i as u32)).unwrap();
+    }
+    let kept: Vec<usize> = (0..pts.len()).filter(|i| i % 3 != 0).collect();
+    let fresh_points: Vec<[f64; 3]> = kept.iter().map(|&i| pts[i]).collect();
+    let fresh = PeriodicDelaunay3::build(space, &fresh_points)
+        .unwrap()
+        .voronoi_measures();
+    let measures: Vec<CellMeasures<3>> = tri
+        .voronoi_measures()
+        .into_iter()
+        .filter(|m| m.point.0 % 3 != 0)
+        .collect();
+    assert_eq!(measures.len(), kept.len());
+    let mut total = 0.0;
+    for m in &measures {
+        let k = kept.binary_search(&(m.point.0 as usize)).unwrap();
+        let f = &fresh[k];
+        total += m.volume;
+        assert!((m.volume - f.volume).abs() <= 1e-12, "{m:?} against {f:?}");
+        assert!((m.surface_area - f.surface_area).abs() <= 1e-12, "{m:?}");
+        assert_eq!(m.faces, f.faces);
+        for c in 0..3 {
+            assert!((m.centroid[c] - f.centroid[c]).abs() <= 1e-12, "{m:?}");
+        }
+    }
+    assert!((total - 1.0).abs() <= 1e-12, "{total}");
+}

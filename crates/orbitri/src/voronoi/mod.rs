@@ -12,6 +12,9 @@
 
 mod measures;
 
+use std::sync::atomic::AtomicBool;
+use std::sync::atomic::Ordering::Relaxed;
+
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
@@ -559,7 +562,8 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     }
 
     /// Each stored cell's circumcenter (orthocenter), indexed by cell id, polling
-    /// `interrupt` every `CELLS_PER_POLL` cells.
+    /// `interrupt` every `CELLS_PER_POLL` cells. Written in place by the threads (a
+    /// collection into a `Result` would gather pieces and copy them).
     fn centers(
         &self,
         ids: &[CellId],
@@ -567,22 +571,36 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     ) -> Result<Vec<[f64; D]>> {
         let e = self.engine();
         let slots = ids.iter().max().map_or(0, |m| m.index() + 1);
-        let computed: Vec<[f64; D]> = ids
-            .par_iter()
+        let stopped = AtomicBool::new(false);
+        let mut center = Vec::new();
+        ids.par_iter()
             .enumerate()
             .map(|(k, &c)| {
-                if k % CELLS_PER_POLL == 0 && interrupt() {
-                    return Err(Error::Interrupted);
+                if k % CELLS_PER_POLL == 0 && !stopped.load(Relaxed) && interrupt() {
+                    stopped.store(true, Relaxed);
+                }
+                if stopped.load(Relaxed) {
+                    return [0.0; D];
                 }
                 // (the circumcenter is the orthocenter of the zero weights unweighted cells have)
-                Ok(self
-                    .space()
-                    .orthocenter(&e.lifted_cell(c), &e.cell_weights(c)))
+                self.space()
+                    .orthocenter(&e.lifted_cell(c), &e.cell_weights(c))
             })
-            .collect::<Result<_>>()?;
-        let mut center = vec![[0.0; D]; slots];
-        for (k, &c) in ids.iter().enumerate() {
-            center[c.index()] = computed[k];
+            .collect_into_vec(&mut center);
+        if stopped.into_inner() {
+            return Err(Error::Interrupted);
+        }
+        if ids.len() < slots {
+            // dead slots between (ids ascend): each center moved up to its cell's slot,
+            // from the last, and the dead slots zeroed
+            center.resize(slots, [0.0; D]);
+            let mut end = slots;
+            for (k, &c) in ids.iter().enumerate().rev() {
+                center[c.index() + 1..end].fill([0.0; D]);
+                center[c.index()] = center[k];
+                end = c.index();
+            }
+            center[..end].fill([0.0; D]);
         }
         Ok(center)
     }
