@@ -54,10 +54,8 @@ impl<const D: usize, E> Pieces<D, E> {
         if let Some(at) = far.and_then(|p| self.at.get(p.index())) {
             prefetch(at);
         }
-        if let Some(&(b, from, to)) = near.and_then(|p| self.at.get(p.index())) {
-            if from < to {
-                prefetch(&self.blocks[b as usize][from as usize]);
-            }
+        if let Some(first) = near.and_then(|p| self.pairs_of(p).first()) {
+            prefetch(first);
         }
     }
 
