@@ -108,11 +108,12 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             .map(|(p, x)| (self.space().spatial_key(x), p as u32))
             .collect();
         order.par_sort_unstable();
-        let star_of = |k: usize| stars.of(e.vertex_of_point(PointId(order[k].1)));
+        let vertex_at = |k: usize| e.vertex_of_point(PointId(order[k].1));
+        let star_of = |k: usize| stars.of(vertex_at(k));
         // per block: each point's measures and the end of its pairs, and the pairs
         let found: Vec<Block<D, S::Elem>> = (0..order.len().div_ceil(BLOCK))
             .into_par_iter()
-            .map_init(Faces::default, |faces, b| {
+            .map_init(<(Faces<_, N>, Vec<_>)>::default, |(faces, star), b| {
                 let ks = b * BLOCK..((b + 1) * BLOCK).min(order.len());
                 let mut measured = Vec::with_capacity(ks.len());
                 let mut found = Vec::new();
@@ -123,7 +124,8 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
                     self.prefetch_stars(center, star_of, k);
                     let p = PointId(order[k].1);
                     let out = pairs.then_some((&mut *faces, &mut found));
-                    let m = self.pieces_of(center, star_of(k), p, out);
+                    self.slotted_star(stars, vertex_at(k), star);
+                    let m = self.pieces_of(center, star, p, out);
                     measured.push((m, found.len() as u32));
                 }
                 Ok((measured, found))
@@ -158,18 +160,18 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     fn prefetch_stars<'a>(
         &self,
         center: &[[f64; D]],
-        star_of: impl Fn(usize) -> &'a [(CellId, u8)],
+        star_of: impl Fn(usize) -> &'a [CellId],
         k: usize,
     ) {
         let e = self.engine();
         let n = self.number_of_vertices();
         if k + 2 < n {
-            for &(t, _) in star_of(k + 2) {
+            for &t in star_of(k + 2) {
                 prefetch(e.cell(t));
             }
         }
         if k + 1 < n {
-            for &(t, _) in star_of(k + 1) {
+            for &t in star_of(k + 1) {
                 prefetch(&center[t.index()]);
                 for &v in &e.cell(t).v {
                     prefetch(&e.points()[e.point_of(v).index()]);

@@ -188,6 +188,7 @@ impl<E: Copy + PartialEq, const N: usize> Faces<E, N> {
 /// The buffers of [`Triangulation::cell_of_point`], reused from cell to cell by one worker
 /// (a cell needed some sixty small allocations: a tenth of the Voronoi pass in malloc).
 pub(crate) struct CellScratch<E, const N: usize> {
+    star: Vec<(CellId, u8)>,
     parent: Vec<usize>,
     vertex_of_root: Vec<u32>,
     vertex_of: Vec<u32>,
@@ -201,6 +202,7 @@ pub(crate) struct CellScratch<E, const N: usize> {
 impl<E, const N: usize> Default for CellScratch<E, N> {
     fn default() -> Self {
         CellScratch {
+            star: Vec::new(),
             parent: Vec::new(),
             vertex_of_root: Vec::new(),
             vertex_of: Vec::new(),
@@ -234,16 +236,18 @@ struct Duals<const D: usize> {
     stars: Stars,
 }
 
-/// The incident (cell, slot) pairs of every vertex, in one array (a counting sort).
+/// The incident cells of every vertex, in one array (a counting sort). The vertex's slot in
+/// each is found again in the cell ([`Stars::slotted`]): the array is half as large as with
+/// the slots, and the cells are read anyway.
 struct Stars {
-    /// The pairs of vertex `v` are `incident[start[v]..start[v + 1]]`.
+    /// The cells of vertex `v` are `incident[start[v]..start[v + 1]]`.
     start: Vec<u32>,
-    incident: Vec<(CellId, u8)>,
+    incident: Vec<CellId>,
 }
 
 impl Stars {
-    /// The cells around vertex `v`, and the vertex's slot in each.
-    fn of(&self, v: VertexId) -> &[(CellId, u8)] {
+    /// The cells around vertex `v`.
+    fn of(&self, v: VertexId) -> &[CellId] {
         &self.incident[self.start[v.index()] as usize..self.start[v.index() + 1] as usize]
     }
 }
@@ -643,14 +647,28 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             start[v + 1] += start[v];
         }
         let mut fill = start.clone();
-        let mut incident = vec![(CellId(0), 0u8); start[vertices] as usize];
+        let mut incident = vec![CellId(0); start[vertices] as usize];
         for &c in ids {
-            for (k, &v) in e.cell(c).v.iter().enumerate() {
-                incident[fill[v.index()] as usize] = (c, k as u8);
+            for &v in &e.cell(c).v {
+                incident[fill[v.index()] as usize] = c;
                 fill[v.index()] += 1;
             }
         }
         Ok(Stars { start, incident })
+    }
+
+    /// The star of vertex `v` (from `stars`) with the vertex's slot in each cell, into `out`
+    /// (a vertex is in a cell once: the triangulation is a simplicial complex).
+    fn slotted_star(&self, stars: &Stars, v: VertexId, out: &mut Vec<(CellId, u8)>) {
+        let e = self.engine();
+        out.clear();
+        out.extend(stars.of(v).iter().map(|&c| {
+            let k = e
+                .cell(c)
+                .index_of(v)
+                .expect("a cell of a star holds its vertex");
+            (c, k as u8)
+        }));
     }
 
     /// The cell of point `p`, from the cells around one of its vertices.
@@ -661,6 +679,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         scratch: &mut CellScratch<S::Elem, N>,
     ) -> VoronoiCell<D, S::Elem> {
         let CellScratch {
+            star,
             parent,
             vertex_of_root,
             vertex_of,
@@ -671,7 +690,8 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         } = scratch;
         let e = self.engine();
         let space = self.space();
-        let star = duals.stars.of(e.vertex_of_point(p));
+        self.slotted_star(&duals.stars, e.vertex_of_point(p), star);
+        let star = &star[..];
         let position = e.points()[p.index()];
         // one Voronoi vertex per group of star cells joined, through facets at the point, by
         // a shared circumsphere (so in one lift around the point: a sphere met again around
