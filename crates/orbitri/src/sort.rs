@@ -131,6 +131,7 @@ fn spread3(v: u32) -> u64 {
 }
 
 fn hilbert3(x: u32, y: u32, z: u32, bits: u32) -> u64 {
+    debug_assert!(bits <= 21, "a 3D Hilbert key of {bits} bits: at most 21");
     // the octants of every level at once: bits 3b..3b+3 hold level b's
     let octants = spread3(x) << 2 | spread3(y) << 1 | spread3(z);
     let (mut h, mut state) = (0u64, 0usize);

@@ -237,8 +237,8 @@ struct Duals<const D: usize> {
 }
 
 /// The incident cells of every vertex, in one array (a counting sort). The vertex's slot in
-/// each is found again in the cell ([`Stars::slotted`]): the array is half as large as with
-/// the slots, and the cells are read anyway.
+/// each is found again in the cell ([`Triangulation::slotted_star`]): the array is half as
+/// large as with the slots, and the cells are read anyway.
 struct Stars {
     /// The cells of vertex `v` are `incident[start[v]..start[v + 1]]`.
     start: Vec<u32>,
