@@ -11,7 +11,10 @@
 
 use rayon::prelude::*;
 
-use super::{cross, dot, listed_once, CellMeasures, Faces, Neighbor, Stars, POINTS_PER_POLL};
+use super::{
+    cross, dot, listed_once, slots_but, slots_but_two, CellMeasures, Faces, Neighbor, Stars,
+    POINTS_PER_POLL,
+};
 use crate::error::{Error, Result};
 use crate::ids::{CellId, PointId};
 use crate::space::FlatSpace;
@@ -218,7 +221,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             );
             let extent2 = rel.iter().map(|r| dot(r, r)).fold(0.0, f64::max);
             let mut piece_moment = [0.0; D];
-            for l in (0..N).filter(|&l| l != k) {
+            for l in slots_but::<N>(k) {
                 let d = cell.n[l];
                 if d < t {
                     continue; // taken from `d`
@@ -236,7 +239,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
                 if may_share_sphere(&c, &c2, extent2) && self.one_sphere(t, l, d) {
                     return None;
                 }
-                for j in (0..N).filter(|&j| j != k && j != l) {
+                for j in slots_but_two::<N>(k, l) {
                     let s = if N == 4 {
                         parity(&[k, j, 6 - k - j - l, l])
                     } else {
