@@ -981,6 +981,27 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             .collect()
     }
 
+    /// Each point with the input id of its first occurrence, and each hidden input with
+    /// [`PointId::NONE`], in input order: one pass over the inputs, not a sort (an input
+    /// whose point has an earlier first occurrence is a duplicate; a removed one has none).
+    pub(crate) fn input_order(&self) -> Vec<(InputId, PointId)> {
+        let order: Vec<(InputId, PointId)> = self
+            .input_point
+            .iter()
+            .enumerate()
+            .filter_map(|(i, &p)| {
+                let i = InputId::new(i);
+                match p {
+                    HIDDEN => Some((i, PointId::NONE)),
+                    PointId::NONE => None,
+                    p => (self.point_input[p.index()] == i).then_some((i, p)),
+                }
+            })
+            .collect();
+        debug_assert_eq!(order.len(), self.point_input.len() + self.hidden.len());
+        order
+    }
+
     /// The input id of a stored vertex's point.
     fn input_of(&self, v: VertexId) -> InputId {
         self.point_input[self.engine.point_of(v).index()]
@@ -1217,6 +1238,33 @@ fn canonical<
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Each point at its first occurrence and each hidden input, in input order: the same
+    /// list as sorting the points by their first occurrence with the hidden inputs, after
+    /// duplicates, hidden points and removals.
+    #[test]
+    fn input_order_is_the_sorted_first_occurrences_and_hidden_inputs() {
+        let mut r = crate::sort::SplitMix::new(5);
+        let mut pts: Vec<[f64; 2]> = (0..300).map(|_| [r.unit(), r.unit()]).collect();
+        let mut w: Vec<f64> = (0..300).map(|_| 0.002 * r.unit()).collect();
+        // duplicates of earlier points, and points on others, lighter (hidden)
+        for k in 0..20 {
+            pts.push(pts[7 * k]);
+            w.push(if k % 2 == 0 { w[7 * k] } else { w[7 * k] - 0.5 });
+        }
+        let space = FlatTorus::<2>::cuboid([1.0, 1.0]).unwrap();
+        let mut tri = PeriodicDelaunay2::build_weighted(space, &pts, &w).unwrap();
+        for i in [3, 14, 150, 301, 303] {
+            tri.remove(InputId::new(i)).unwrap();
+        }
+        assert!(tri.duplicates > 0 && !tri.hidden.is_empty());
+        let mut want: Vec<(InputId, PointId)> = (0..tri.number_of_vertices() as u32)
+            .map(|p| (tri.input_of_vertex(PointId(p)), PointId(p)))
+            .chain(tri.hidden().into_iter().map(|i| (i, PointId::NONE)))
+            .collect();
+        want.sort_unstable();
+        assert_eq!(tri.input_order(), want);
+    }
 
     #[test]
     fn internal_points_are_borrowed_only_when_every_one_is_in_place() {

@@ -388,7 +388,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             // (the duals' memory back before the pairs are gathered)
             drop((center, stars));
         }
-        let order = self.input_order(pieces.measures.len());
+        let order = self.input_order();
         let measures = self.in_order(&order, std::mem::take(&mut pieces.measures), |i| {
             CellMeasures::from(&self.hidden_cell(i))
         });
@@ -450,10 +450,11 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     /// The values of the points (`out`, indexed by point, each `Some`) and of the hidden
     /// inputs (`hidden`), in the order of first occurrence.
     fn in_input_order<T>(&self, out: Vec<Option<T>>, hidden: impl Fn(InputId) -> T) -> Vec<T> {
-        self.in_order(&self.input_order(out.len()), out, hidden)
+        debug_assert_eq!(out.len(), self.number_of_vertices());
+        self.in_order(&self.input_order(), out, hidden)
     }
 
-    /// [`Self::in_input_order`] along an `order` that [`Self::input_order`] gave.
+    /// [`Self::in_input_order`] along an `order` that `input_order` gave.
     fn in_order<T>(
         &self,
         order: &[(InputId, PointId)],
@@ -467,17 +468,6 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
                 p => out[p.index()].take().expect("each point once"),
             })
             .collect()
-    }
-
-    /// The `points` points (with their input ids) and the hidden inputs (with
-    /// `PointId::NONE`), in the order of first occurrence.
-    fn input_order(&self, points: usize) -> Vec<(InputId, PointId)> {
-        let mut order: Vec<(InputId, PointId)> = (0..points as u32)
-            .map(|p| (self.input_of_vertex(PointId(p)), PointId(p)))
-            .chain(self.hidden().into_iter().map(|i| (i, PointId::NONE)))
-            .collect();
-        order.par_sort_unstable();
-        order
     }
 
     /// The empty power cell of hidden input `i`: no vertices or faces, volume 0, its
