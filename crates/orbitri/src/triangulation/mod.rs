@@ -973,12 +973,17 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         self.input_point
             .iter()
             .enumerate()
-            .map(|(i, &v)| match v {
-                PointId::NONE => InputId::NONE,
-                HIDDEN => InputId::new(i),
-                _ => self.point_input[v.index()],
-            })
+            .map(|(i, &v)| self.first_occurrence(i, v))
             .collect()
+    }
+
+    /// The input id of the first occurrence of input `i`, whose point is `v`.
+    fn first_occurrence(&self, i: usize, v: PointId) -> InputId {
+        match v {
+            PointId::NONE => InputId::NONE,
+            HIDDEN => InputId::new(i),
+            _ => self.point_input[v.index()],
+        }
     }
 
     /// Each point with the input id of its first occurrence, and each hidden input with
@@ -989,14 +994,8 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             .input_point
             .iter()
             .enumerate()
-            .filter_map(|(i, &p)| {
-                let i = InputId::new(i);
-                match p {
-                    HIDDEN => Some((i, PointId::NONE)),
-                    PointId::NONE => None,
-                    p => (self.point_input[p.index()] == i).then_some((i, p)),
-                }
-            })
+            .filter(|&(i, &p)| self.first_occurrence(i, p) == InputId::new(i))
+            .map(|(i, &p)| (InputId::new(i), if p == HIDDEN { PointId::NONE } else { p }))
             .collect();
         debug_assert_eq!(order.len(), self.point_input.len() + self.hidden.len());
         order

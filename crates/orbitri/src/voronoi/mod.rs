@@ -691,7 +691,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         for (s, &(c, k)) in star.iter().enumerate() {
             let cell = e.cell(c);
             for x in
-                (0..N).filter(|&x| x != k as usize && duals.cospherical[c.index()] >> x & 1 == 1)
+                slots_but::<N>(k as usize).filter(|&x| duals.cospherical[c.index()] >> x & 1 == 1)
             {
                 let d = cell.n[x];
                 let t = star
@@ -725,7 +725,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         member.clear();
         for (s, at) in edges.index.iter().enumerate() {
             let k = star[s].1 as usize;
-            member.extend((0..N).filter(|&j| j != k).map(|j| (at[j], s as u32)));
+            member.extend(slots_but::<N>(k).map(|j| (at[j], s as u32)));
         }
         member.sort_unstable();
         let mut faces = Vec::with_capacity(edges.edges.len());
@@ -812,11 +812,10 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             let (c, k) = star[*cycle.last().unwrap()];
             let k = k as usize;
             let cell = e.cell(c);
-            let j = (0..N)
-                .find(|&j| j != k && self.edge_at(c, k, j) == (w, r))
+            let j = slots_but::<N>(k)
+                .find(|&j| self.edge_at(c, k, j) == (w, r))
                 .expect("the ring cell holds the edge");
-            let next = (0..N)
-                .filter(|&x| x != k && x != j)
+            let next = slots_but_two::<N>(k, j)
                 .map(|x| cell.n[x])
                 .find(|&d| d != prev)
                 .unwrap_or(prev);
