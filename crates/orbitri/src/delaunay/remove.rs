@@ -105,6 +105,26 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         (map, true)
     }
 
+    /// Removes points `0..k` (a bulk build's dummy points), largest id first, the last
+    /// point taking each one's id: the other points keep theirs, so only the cells around
+    /// the `k` moved points are rewritten, where renumbering all in order ([`Self::compact`])
+    /// rewrites every cell. Returns, for each id `d < k`, the first id of the point last
+    /// moved into it (a point moves again when fewer than `k` others remain; its new id is
+    /// the smallest that lists it), or `None` when a point cannot go in place (the
+    /// triangulation is then half done: the caller starts again).
+    pub(crate) fn remove_first_points(&mut self, k: usize) -> Option<Vec<PointId>> {
+        let mut moved = vec![PointId::NONE; k];
+        for d in (0..k).rev() {
+            if !self.remove_copies(PointId::new(d)) {
+                return None;
+            }
+            let last = self.points.len() - 1;
+            self.renumber_last_point(PointId::new(d));
+            moved[d] = moved.get(last).copied().unwrap_or(PointId::new(last));
+        }
+        Some(moved)
+    }
+
     /// Removes every vertex of point `p` (one per sheet), which must not be the only point.
     /// False when the space does not allow it in place: the quotient would stop being a
     /// simplicial complex, or a covering above level 0 would lose its criterion. Then the
@@ -338,5 +358,35 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             }
         }
         true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::delaunay::uniform_cube;
+
+    /// The first `k` points leave and the last take their ids, the others keep theirs; the
+    /// map names each moved point's first id, also when points move twice (fewer than `k`
+    /// stay), and the triangulation is that of the points left.
+    #[test]
+    fn removing_the_first_points_moves_the_last_into_their_ids() {
+        for (n, k) in [(400, 36), (400, 300)] {
+            let mut e = uniform_cube(n, 5);
+            let before = e.points.clone();
+            let moved = e.remove_first_points(k).expect("in place");
+            assert_eq!(e.points.len(), n - k);
+            e.is_valid().unwrap();
+            assert!(e.is_one_sheeted());
+            for (q, p) in e.points.iter().enumerate() {
+                let first = if q < k { moved[q].index() } else { q };
+                assert!(first >= k, "point {q} came from a removed id {first}");
+                assert_eq!(*p, before[first], "point {q}");
+            }
+            let mut left: Vec<_> = e.points.clone();
+            let mut want = before[k..].to_vec();
+            left.sort_by(|a, b| a.partial_cmp(b).unwrap());
+            want.sort_by(|a, b| a.partial_cmp(b).unwrap());
+            assert_eq!(left, want);
+        }
     }
 }

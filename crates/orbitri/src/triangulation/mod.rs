@@ -316,6 +316,10 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     /// relative to input `i`'s wrapped point). Duplicates can differ from it by an exact
     /// lattice translation, which the offsets of the point's star absorb.
     fn represent_first_occurrences(&mut self, wrapped: &[[f64; D]]) {
+        if self.duplicates == 0 {
+            // (every point holds its only input's wrapped coordinates)
+            return;
+        }
         for p in 0..self.point_input.len() {
             // (the inputs in a random order: loaded ahead)
             let ahead = self.point_input.get(p + Self::AHEAD);
@@ -375,19 +379,18 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         if !kept {
             return Ok(false);
         }
-        // 1-sheeted: the vertex of dummy point `d` has its id
-        for d in 0..k {
-            if self.engine.remove_vertex(VertexId(d)).is_err() {
-                return Ok(false);
-            }
+        // the last points take the dummies' ids, the others keep theirs
+        let Some(moved) = self.engine.remove_first_points(k as usize) else {
+            return Ok(false);
+        };
+        for d in (0..k as usize).rev() {
+            self.point_input.swap_remove(d);
         }
-        let dummy: Vec<bool> = (0..self.engine.points().len())
-            .map(|p| p < k as usize)
-            .collect();
-        self.engine.compact(&dummy);
-        self.point_input.drain(..k as usize);
-        for p in self.input_point.iter_mut().filter(|p| **p != HIDDEN) {
-            *p = PointId(p.0 - k);
+        let n = self.point_input.len() as u32;
+        for p in self.input_point.iter_mut().filter(|p| p.0 >= n) {
+            if let Some(d) = moved.iter().position(|m| m == p) {
+                *p = PointId::new(d);
+            }
         }
         self.used_dummies = true;
         // points hidden with the dummies' help come back
