@@ -476,6 +476,8 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
 
     /// How many points ahead of the insertion their data are loaded.
     const AHEAD: usize = 8;
+    /// How many points of a round one at a time gathers from the input at once.
+    const BLOCK: usize = 256;
 
     /// [`Self::insert_ordered`] of one round, `(spatial key, index)` pairs in insertion
     /// order, after `done` points. One at a time unless the engine has threads: the
@@ -491,18 +493,24 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     ) -> Result<bool> {
         let weight = |k: usize| weights.get(k).copied().unwrap_or(0.0);
         if self.engine.threads().is_none() {
+            let mut block: Vec<[f64; D]> = Vec::with_capacity(Self::BLOCK);
             for (n, &(key, k)) in round.iter().enumerate() {
+                if n % Self::BLOCK == 0 {
+                    let end = (n + Self::BLOCK).min(round.len());
+                    block.clear();
+                    block.extend(round[n..end].iter().map(|&(_, k)| points[k as usize]));
+                }
                 if (done + n) % 4096 == 0 {
                     proceed(progress, done + n)?;
                 }
-                // (the points come in a random order: each point, and its entry in the
-                // input table that `record` writes, loaded ahead)
+                // (the points come in a random order: gathered a block at a time, whose
+                // loads overlap, where a prefetch in this loop waited for its page walk;
+                // the entries of the input table that `record` writes, loaded ahead)
                 if let Some(&(_, ahead)) = round.get(n + Self::AHEAD) {
-                    crate::tds::prefetch(&points[ahead as usize]);
                     self.prefetch_input(first + ahead as usize);
                 }
                 let k = k as usize;
-                let (p, w) = (points[k], weight(k));
+                let (p, w) = (block[n % Self::BLOCK], weight(k));
                 let r = self.engine.insert_keyed(p, w, key);
                 if !keep(r, &self.engine.hidden_log) {
                     return Ok(false);
