@@ -300,16 +300,21 @@ impl Ownership {
     /// The group owning a cell of stamp `s` (`count >> level` or more for none).
     #[inline(always)]
     fn owner(self, s: u32) -> u32 {
-        let c = self.chunk(s);
+        self.turned(self.chunk(s)) >> self.level
+    }
+
+    /// Chunk `c`'s place in the turned order of the groups (`c` itself when it is no
+    /// chunk of the pass).
+    #[inline(always)]
+    fn turned(self, c: u32) -> u32 {
         let t = c.wrapping_add(self.turn);
-        let turned = if c >= self.count {
+        if c >= self.count {
             c
         } else if t >= self.count {
             t - self.count
         } else {
             t
-        };
-        turned >> self.level
+        }
     }
 
     /// The first chunk of group `j`.
@@ -745,15 +750,15 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         }
         own.level = top - 1;
         own.turn = count as u32 / 4;
-        let turned = |s: u32| ((chunk_of(s) + count / 4) % count) >> own.level;
+        let turned = |s: u32| own.turned(chunk_of(s) as u32);
         let mut active: Vec<u32> = pending.iter().filter(across).map(|&(s, _)| s).collect();
         // (in curve order within each group: the first starts at chunk `count − turn`)
-        active.sort_unstable_by_key(|&s| (turned(s), (chunk_of(s) + count / 4) % count, s));
+        active.sort_unstable_by_key(|&s| (turned(s), s));
         let mut groups = Vec::new();
         for g in 0..2 {
-            let from = active.partition_point(|&s| turned(s) < g);
-            let to = active.partition_point(|&s| turned(s) <= g);
-            groups.push((from..to, marks[own.first_chunk(g as u32) as usize]));
+            let from = active.partition_point(|&s| turned(s) >> own.level < g);
+            let to = active.partition_point(|&s| turned(s) >> own.level <= g);
+            groups.push((from..to, marks[own.first_chunk(g) as usize]));
         }
         // (each walk from the group's last insertion, every 64th from a cell located before:
         // one located for every point cost a one-thread build 4 % more, against 2.5 %)
