@@ -10,7 +10,7 @@ use rayon::prelude::*;
 use super::{Candidate, Engine};
 use crate::ids::{CellId, PointId, VertexId};
 use crate::space::OrbitSpace;
-use crate::tds::{Cell, Tds};
+use crate::tds::Cell;
 
 impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// The vertex id of the lifted copy `(p, o)` at the current level: `sheets` ids per
@@ -220,7 +220,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         }
         let mut seen: HashMap<(PointId, PointId), S::Elem> = HashMap::new();
         for c in self.tds.ids() {
-            let cell = &self.tds.cells[c.index()];
+            let cell = self.tds.cell(c);
             for a in 0..N {
                 for b in 0..N {
                     let (pa, pb) = (
@@ -250,14 +250,14 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         if level <= self.level {
             return;
         }
-        let old = std::mem::replace(&mut self.tds, Tds::new());
+        let old = std::mem::take(&mut self.tds);
         let old_vpoint = std::mem::take(&mut self.vpoint);
         // the new cells are created in the order of `reps`: the `k`-th has id `k`
         let mut orbit = vec![CellId::NONE; old.cells.len()];
         let mut reps: Vec<CellId> = Vec::new();
         let mut index: HashMap<[(PointId, S::Elem); N], CellId> = HashMap::new();
         for c in old.ids() {
-            let key = quotient_key(&self.space, &old_vpoint, &old.cells[c.index()], level);
+            let key = quotient_key(&self.space, &old_vpoint, &old.cell(c), level);
             orbit[c.index()] = *index.entry(key).or_insert_with(|| {
                 reps.push(c);
                 CellId::new(reps.len() - 1)
@@ -266,7 +266,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.enter_level(level);
         self.tds.reserve(reps.len());
         for &c in &reps {
-            let was = &old.cells[c.index()];
+            let was = old.cell(c);
             let mut cell = Cell::new(was.v, was.off);
             cell.n = was.n.map(|d| orbit[d.index()]);
             // in the new level's canonical form, then renumbered for its sheets

@@ -36,7 +36,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         x: VertexId,
         qoff: S::Elem,
     ) {
-        let old = self.tds.cells[c.index()];
+        let old = self.tds.cell(c);
         // (two more slots; guaranteed, so no criterion bookkeeping)
         let (b, d) = (self.tds.create(old), self.tds.create(old));
         for (id, t) in [c, b, d].into_iter().zip(split(&old, x, qo, [c, b, d])) {
@@ -50,12 +50,12 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         edges.clear();
         edges.extend([c, b, d]);
         while let Some(t) = edges.pop() {
-            let tc = self.tds.cells[t.index()];
+            let tc = self.tds.cell(t);
             let e = tc.n[0];
             let Some((far, j)) = self.far_in_conflict(t, &tc, e, p) else {
                 continue;
             };
-            let ec = self.tds.cells[e.index()];
+            let ec = self.tds.cell(e);
             let ([nt, ne], [(first, o1), (second, o2)]) = flipped(&tc, (e, &ec, j), far, t);
             self.rewrite(t, nt);
             self.rewrite(e, ne);
@@ -68,7 +68,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.scratch.created = edges;
         self.vcell[x.index()] = c;
         self.hint = c;
-        self.hint_shift = self.space.carry(qoff, self.tds.cells[c.index()].off[0]);
+        self.hint_shift = self.space.carry(qoff, self.tds.off_at(c, 0));
     }
 
     /// The element, in the frame of cell `t` (contents `tc`, the new vertex at slot 0), of
@@ -89,7 +89,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         }
         let ec = &self.tds.cells[e.index()];
         let j = ec.mirror(t).expect("symmetric neighbours");
-        Some((self.space.compose(to_e, ec.off[j]), j))
+        Some((self.space.compose(to_e, self.tds.off_at(e, j)), j))
     }
 
     /// A triangle in canonical form (see [`Self::canonicalize`]: in an orientable space, no
@@ -106,8 +106,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     #[inline(always)]
     fn rewrite(&mut self, c: CellId, t: Triangle<S::Elem>) {
         let cell = self.canonical_triangle(t);
-        let slot = &mut self.tds.cells[c.index()];
-        (slot.v, slot.off, slot.n) = (cell.v, cell.off, cell.n);
+        self.tds.put(c, &cell);
     }
 
     /// Links facet `i` of `a` with the facet of `d` that was linked to `old`.
@@ -190,7 +189,7 @@ mod tests {
         e.tds
             .ids()
             .map(|c| {
-                let cell = &e.tds.cells[c.index()];
+                let cell = e.tds.cell(c);
                 let k = (0..3).min_by_key(|&k| cell.v[k]).unwrap();
                 let r = |i: usize| (k + i) % 3;
                 (

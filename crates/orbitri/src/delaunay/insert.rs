@@ -353,7 +353,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         x: VertexId,
     ) -> (CellId, Cell<S::Elem, N>) {
         let (c, qo) = scratch.conflict[ci as usize];
-        let cell = self.tds.cells[c.index()];
+        let cell = self.tds.cell(c);
         let i = i as usize;
         (
             self.make_cell(replaced(cell.v, i, x), replaced(cell.off, i, qo)),
@@ -493,7 +493,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             .index_of(x)
             .expect("new cells hold the new vertex");
         self.hint = first;
-        self.hint_shift = self.space.carry(qoff, self.tds.cells[first.index()].off[k]);
+        self.hint_shift = self.space.carry(qoff, self.tds.off_at(first, k));
     }
 
     /// True when a vertex of the conflict region `conflict` lies on none of its `boundary`
@@ -539,7 +539,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         let mut seen: Vec<(VertexId, S::Elem)> = Vec::new();
         for &(ci, i) in &self.scratch.boundary {
             let (c, qo) = self.scratch.conflict[ci as usize];
-            let cell = &self.tds.cells[c.index()];
+            let cell = self.tds.cell(c);
             for k in (0..N).filter(|&k| k != i as usize) {
                 let rel = self.space.relative(cell.off[k], qo);
                 match seen.iter().find(|e| e.0 == cell.v[k]) {

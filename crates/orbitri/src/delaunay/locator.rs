@@ -141,7 +141,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         let cell = &self.tds.cells[c.index()];
         let i = cell.index_of(v)?;
         // the query, near the vertex's point, is lifted like the vertex in this cell
-        Some((c, cell.off[i]))
+        Some((c, self.tds.off_at(c, i)))
     }
 }
 

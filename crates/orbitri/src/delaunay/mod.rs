@@ -316,7 +316,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         let cell = &self.tds.cells[c.index()];
         (
             std::array::from_fn(|i| &self.points[self.point_index(cell.v[i])]),
-            cell.off,
+            self.tds.off(c),
         )
     }
 
@@ -433,9 +433,15 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.tds.ids()
     }
 
-    /// A stored cell.
-    pub fn cell(&self, c: CellId) -> &Cell<S::Elem, N> {
-        &self.tds.cells[c.index()]
+    /// Asks the processor to start loading cell `c` (see [`crate::tds::prefetch`]).
+    #[inline(always)]
+    pub(crate) fn prefetch_cell(&self, c: CellId) {
+        crate::tds::prefetch(&self.tds.cells[c.index()]);
+    }
+
+    /// A stored cell (a copy).
+    pub fn cell(&self, c: CellId) -> Cell<S::Elem, N> {
+        self.tds.cell(c)
     }
 
     /// The point of a vertex.
@@ -447,7 +453,10 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     #[inline]
     pub fn lifted(&self, c: CellId, i: usize) -> LiftedOf<S, N> {
         let cell = &self.tds.cells[c.index()];
-        (self.points[self.point_index(cell.v[i])], cell.off[i])
+        (
+            self.points[self.point_index(cell.v[i])],
+            self.tds.off_at(c, i),
+        )
     }
 
     /// The point of vertex `v` (the identity once 1-sheeted: no indirection on the hot path).
@@ -465,9 +474,10 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     pub fn lifted_cell(&self, c: CellId) -> LiftedCell<S, N> {
         // (an explicit loop: `array::from_fn` and `array::map` measured 20% slower here)
         let cell = &self.tds.cells[c.index()];
-        let mut out = [(self.points[0], cell.off[0]); N];
+        let off = self.tds.off(c);
+        let mut out = [(self.points[0], off[0]); N];
         for i in 0..N {
-            out[i] = (self.points[self.point_index(cell.v[i])], cell.off[i]);
+            out[i] = (self.points[self.point_index(cell.v[i])], off[i]);
         }
         out
     }
@@ -475,15 +485,15 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// The offset that maps the frame of `d = neighbour(c, i)` onto the frame of `c`.
     #[inline(always)]
     pub fn translation(&self, c: CellId, i: usize, d: CellId) -> S::Elem {
-        let cc = &self.tds.cells[c.index()];
-        let dc = &self.tds.cells[d.index()];
+        let (cc, dc) = (&self.tds.cells[c.index()], &self.tds.cells[d.index()]);
         let one = self.space.identity();
-        if cc.off == [one; N] && dc.off == [one; N] {
+        if self.tds.all_are(c, one) && self.tds.all_are(d, one) {
             return one;
         }
         let k = (i + 1) % N;
         let j = dc.index_of(cc.v[k]).expect("neighbours share a facet");
-        self.space.carry(dc.off[j], cc.off[k])
+        self.space
+            .carry(self.tds.off_at(d, j), self.tds.off_at(c, k))
     }
 
     /// The cells incident to vertex `v`: (cell, index of `v` in it, shift from the cell's
@@ -520,7 +530,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     pub fn neighbours(&self, v: VertexId) -> Vec<(VertexId, S::Elem)> {
         let mut out = Vec::new();
         for (c, k, _) in self.star(v) {
-            let cell = &self.tds.cells[c.index()];
+            let cell = self.tds.cell(c);
             for j in (0..N).filter(|&j| j != k) {
                 out.push((cell.v[j], self.space.relative(cell.off[j], cell.off[k])));
             }
@@ -539,10 +549,10 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             let v = VertexId(v);
             debug_assert_eq!(self.vpoint[v.index()], p);
             for (c, k, _) in self.star(v) {
-                let mut cell = self.tds.cells[c.index()];
+                let mut cell = self.tds.cell(c);
                 cell.off[k] = self.space.compose(cell.off[k], t);
                 self.canonicalize(&mut cell);
-                self.tds.cells[c.index()] = cell;
+                self.tds.put(c, &cell);
             }
         }
         self.points[p.index()] = coords;
@@ -591,6 +601,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     }
 
     /// Creates a cell in canonical form and keeps the criterion bookkeeping.
+    #[inline(always)]
     fn make_cell(&mut self, v: [VertexId; N], off: [S::Elem; N]) -> CellId {
         let mut cell = Cell::new(v, off);
         self.canonicalize(&mut cell);
@@ -598,6 +609,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     }
 
     /// Stores a canonical cell and keeps the criterion bookkeeping.
+    #[inline(always)]
     fn add_cell(&mut self, cell: Cell<S::Elem, N>) -> CellId {
         let id = self.tds.create(cell);
         if !self.guaranteed {

@@ -49,7 +49,7 @@ use super::{Engine, HiddenPoint, Inserted};
 use crate::ids::{CellId, PointId, VertexId};
 use crate::sort::SplitMix;
 use crate::space::OrbitSpace;
-use crate::tds::{replaced, Cell};
+use crate::tds::{replaced, Cell, Packing, Stored};
 
 /// Points inserted one by one before the waves.
 const SEQUENTIAL_START: usize = 2048;
@@ -143,7 +143,7 @@ enum Outcome {
 /// the cell slots it may fill, its last insertion, and what the probe found for its
 /// current point.
 #[derive(Debug)]
-struct Chunk<O, const N: usize> {
+struct Chunk<O: Packing, const N: usize> {
     id: u32,
     range: Range<usize>,
     /// The cell of the chunk's last insertion, its vertices (a reused slot fails the check)
@@ -181,15 +181,15 @@ struct Chunk<O, const N: usize> {
     outcomes: Vec<(u32, Outcome)>,
     /// Buffers of `commit`: the region's cells as they were, the new cells, their slots,
     /// and the vertices whose cell dies.
-    old: Vec<Cell<O, N>>,
-    new: Vec<Cell<O, N>>,
+    old: Vec<Stored<O, N>>,
+    new: Vec<Stored<O, N>>,
     ids: Vec<CellId>,
     orphans: Vec<VertexId>,
     /// 3D: the boundary edges of its region, to pair the new cells.
     ridges: Ridges,
 }
 
-impl<O, const N: usize> Chunk<O, N> {
+impl<O: Packing, const N: usize> Chunk<O, N> {
     fn new(id: u32, range: Range<usize>, spare: Vec<CellId>, fresh: Range<usize>) -> Self {
         Chunk {
             id,
@@ -343,16 +343,16 @@ impl Ownership {
 
 /// The cell store, written by several chunks at once, each only in the cells it owns and
 /// its own slots.
-struct SharedCells<O, const N: usize> {
-    base: *mut Cell<O, N>,
+struct SharedCells<O: Packing, const N: usize> {
+    base: *mut Stored<O, N>,
     len: usize,
 }
 
-impl<O: Copy, const N: usize> SharedCells<O, N> {
+impl<O: Packing, const N: usize> SharedCells<O, N> {
     /// # Safety
     /// No other thread accesses slot `c` meanwhile.
     #[inline]
-    unsafe fn get(&self, c: CellId) -> *mut Cell<O, N> {
+    unsafe fn get(&self, c: CellId) -> *mut Stored<O, N> {
         assert!(c.index() < self.len);
         self.base.add(c.index())
     }
@@ -429,7 +429,7 @@ impl<S: OrbitSpace<N>, const N: usize> Pass<'_, S, N> {
                             ch.left.push((s as u32, None));
                             continue;
                         }
-                        Commit::NotSimplicial => {
+                        Commit::NotSimplicial | Commit::Unpacked => {
                             ch.left.push((s as u32, None));
                             continue;
                         }
@@ -475,6 +475,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             && self.one_sheeted
             && self.guaranteed
             && !self.weighted
+            && self.tds.is_packed()
             && self.points.len() >= SEQUENTIAL_START
             && left.saturating_mul(FEWEST) >= self.points.len()
     }
@@ -806,6 +807,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             self.tds.delete(d);
         }
         let dead = Cell::new([VertexId::NONE; N], [self.space.identity(); N]);
+        let dead = Stored::pack(&dead).expect("the identity packs");
         self.tds.grow(slots, dead);
         chunks
             .par_iter_mut()
@@ -1076,6 +1078,9 @@ enum Commit {
     /// cells, see [`Ridges::pair`]); the sequential code, which links such stars by
     /// rotation, inserts the point.
     NotSimplicial,
+    /// Nothing: a new cell's elements do not pack ([`crate::tds::Packing`]); the sequential
+    /// code, which can store them beside the cells, inserts the point.
+    Unpacked,
 }
 
 /// Stars a chunk's region from its new vertex `x`: the new cells take the region's slots
@@ -1110,13 +1115,16 @@ unsafe fn commit<S: OrbitSpace<N>, const N: usize>(
         let was = &old[ci];
         let mut cell = Cell::new(
             replaced(was.v, i, x),
-            replaced(was.off, i, ch.conflict[ci].1),
+            replaced(was.packed_offsets(), i, ch.conflict[ci].1),
         );
         if space.normalize(&mut cell.off, level) && S::MAY_REVERSE {
             cell.swap_slots(0, 1);
         }
         let slot = cell.index_of(x).expect("the new vertex");
         cell.n = replaced(cell.n, slot, ch.across[k].0);
+        let Some(cell) = Stored::pack(&cell) else {
+            return Commit::Unpacked;
+        };
         new.push(cell);
     }
     // 3D: paired by the boundary edges (as [`Engine::link_by_ridges`] pairs them)
@@ -1185,7 +1193,7 @@ unsafe fn commit<S: OrbitSpace<N>, const N: usize>(
     ch.hint = Some((
         ids[0],
         new[0].v,
-        space.carry(space.identity(), new[0].off[k]),
+        space.carry(space.identity(), new[0].packed_offsets()[k]),
     ));
     Commit::Starred
 }

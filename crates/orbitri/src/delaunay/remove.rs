@@ -231,7 +231,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                     if k != i && d < c && ids.contains(&d) {
                         return true;
                     }
-                    let dc = self.tds.cells[d.index()];
+                    let dc = self.tds.cell(d);
                     let j = dc.mirror(c).expect("symmetric neighbours");
                     let opposite = (
                         self.points[self.point_of(dc.v[j]).index()],
@@ -335,7 +335,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             stack.push(self.vcell[a.index()]);
             self.tds.set_stamp(stack[0], mark);
             while let Some(c) = stack.pop() {
-                let cell = self.tds.cells[c.index()];
+                let cell = self.tds.cell(c);
                 let i = cell.index_of(a).expect("the star of a vertex holds it");
                 for k in (0..N).filter(|&k| k != i) {
                     if !star.contains(&c) {

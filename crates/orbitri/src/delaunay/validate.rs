@@ -27,7 +27,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             if self.orientation(c) != Sign::Positive {
                 return bad(format!("cell {c} is not positively oriented"));
             }
-            let cell = &self.tds.cells[c.index()];
+            let cell = self.tds.cell(c);
             for i in 0..N {
                 if (i + 1..N).any(|j| cell.v[i] == cell.v[j]) {
                     return bad(format!("cell {c} repeats vertex {}", cell.v[i]));
@@ -36,7 +36,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 if d == CellId::NONE || !self.tds.is_alive(d) {
                     return bad(format!("cell {c} has no neighbour {i}"));
                 }
-                let dc = &self.tds.cells[d.index()];
+                let dc = self.tds.cell(d);
                 let Some(j) = dc.mirror(c) else {
                     return bad(format!("cell {d} does not know its neighbour {c}"));
                 };
@@ -128,10 +128,9 @@ mod tests {
     fn detects_a_negatively_oriented_cell() {
         let mut e = engine();
         let c = e.tds.ids().next().unwrap();
-        let cell = &mut e.tds.cells[c.index()];
-        cell.v.swap(0, 1);
-        cell.n.swap(0, 1);
-        cell.off.swap(0, 1);
+        let mut cell = e.tds.cell(c);
+        cell.swap_slots(0, 1);
+        e.tds.put(c, &cell);
         let msg = e.is_valid().unwrap_err().0;
         assert!(msg.contains("not positively oriented"), "{msg}");
     }
@@ -149,9 +148,11 @@ mod tests {
         let c = e
             .tds
             .ids()
-            .find(|&c| e.tds.cells[c.index()].off.iter().all(|o| *o == [0; 3]))
+            .find(|&c| e.tds.off(c).iter().all(|o| *o == [0; 3]))
             .unwrap();
-        e.tds.cells[c.index()].off[2] = [1, 0, 0];
+        let mut off = e.tds.off(c);
+        off[2] = [1, 0, 0];
+        e.tds.set_off(c, off);
         assert!(e.is_valid().is_err());
     }
 
@@ -166,5 +167,27 @@ mod tests {
             msg.contains("locally Delaunay") || msg.contains("oriented"),
             "{msg}"
         );
+    }
+
+    /// A covering's offsets reach past what a slot holds, so its store turns wide and
+    /// stays valid; the 1-sheeted torus starts a packed store again.
+    #[test]
+    fn a_covering_turns_the_cell_store_wide_and_the_quotient_packs_it_again() {
+        let mut e = Engine::new(FlatTorus3::cuboid([1.0, 1.0, 3.0]).unwrap());
+        let mut r = crate::sort::SplitMix::new(5);
+        let mut wide = 0;
+        for k in 0..600 {
+            e.insert([r.unit(), r.unit(), 3.0 * r.unit()]);
+            if !e.tds.is_packed() {
+                wide += 1;
+                assert!(!e.is_one_sheeted());
+                if k % 32 == 0 {
+                    e.is_valid().unwrap();
+                }
+            }
+        }
+        assert!(wide > 0, "never wide");
+        assert!(e.is_one_sheeted() && e.tds.is_packed());
+        e.is_valid().unwrap();
     }
 }

@@ -33,6 +33,33 @@ pub struct Motion<const D: usize> {
     pub offset: [i8; D],
 }
 
+impl<const D: usize> Default for Motion<D> {
+    /// The identity.
+    fn default() -> Self {
+        Motion {
+            coset: 0,
+            offset: [0; D],
+        }
+    }
+}
+
+/// Stored as they are.
+impl<const D: usize> crate::tds::Packing for Motion<D> {
+    type Slot = Self;
+    #[inline(always)]
+    fn pack(self) -> Option<Self> {
+        Some(self)
+    }
+    #[inline(always)]
+    fn unpack(slot: Self) -> Self {
+        slot
+    }
+    #[inline(always)]
+    fn pack_all<const N: usize>(off: [Self; N]) -> Option<[Self; N]> {
+        Some(off)
+    }
+}
+
 /// A coset representative `x ↦ A·x + s·M/q` as given to [`FlatManifold::new`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Coset<const D: usize> {

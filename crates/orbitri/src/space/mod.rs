@@ -38,7 +38,7 @@ pub trait OrbitSpace<const N: usize>: Sync + Send {
     /// A group element, as stored per cell vertex (flat torus: an integer offset vector).
     /// It acts on points from the left: a cell vertex `(p, g)` lies at `g·p`, and
     /// translating a cell by `h` makes its elements `h∘g`.
-    type Elem: Copy + Debug + Eq + Hash + Ord + Send + Sync;
+    type Elem: Copy + Debug + Eq + Hash + Ord + Send + Sync + crate::tds::Packing;
 
     /// The identity element.
     fn identity(&self) -> Self::Elem;

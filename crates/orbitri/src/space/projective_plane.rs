@@ -23,6 +23,8 @@ use crate::predicates::Sign;
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct Antipode(pub bool);
 
+crate::tds::unpacked!(Antipode);
+
 /// The real projective plane, with its set of anchors (as [`Sphere::with_anchors`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ProjectivePlane {

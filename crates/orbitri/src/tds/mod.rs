@@ -1,19 +1,97 @@
 //! The combinatorial simplicial complex: cells of `N` vertices with their `N` neighbours
 //! (neighbour `i` is opposite vertex `i`) and one group element per vertex, typed ids, a free
-//! list, and generation stamps for visits.
+//! list, and generation stamps for visits. The elements are stored packed where they are
+//! small ([`Packing`]: a torus's offsets in one byte a vertex), which keeps a cell of the 3D
+//! torus in 40 bytes instead of 48.
+
+use std::fmt::Debug;
 
 use rayon::prelude::*;
 
 pub use crate::ids::{CellId, VertexId};
 
-/// A cell: vertex ids, neighbour ids, the offset of each vertex, and a visit stamp (kept
-/// in the cell so that a visit touches one cache line).
+/// How a cell stores the group element of one of its vertices: packed into a smaller slot
+/// when the element is small enough (a cell that holds one element that is not is stored
+/// with its elements beside the cells, see [`Tds`]).
+pub trait Packing: Copy {
+    /// What a cell stores for one vertex.
+    type Slot: Copy + Debug + Default + Eq + Send + Sync;
+    /// The slot of this element, if it fits in one.
+    fn pack(self) -> Option<Self::Slot>;
+    /// The element a slot holds.
+    fn unpack(slot: Self::Slot) -> Self;
+    /// The slots of a cell's elements, if each fits in one.
+    #[inline(always)]
+    fn pack_all<const N: usize>(off: [Self; N]) -> Option<[Self::Slot; N]> {
+        let mut slots = [Self::pack(off[0])?; N];
+        for k in 1..N {
+            slots[k] = Self::pack(off[k])?;
+        }
+        Some(slots)
+    }
+}
+
+/// Elements stored as they are.
+macro_rules! unpacked {
+    ($($t:ty),*) => {$(
+        impl $crate::tds::Packing for $t {
+            type Slot = $t;
+            #[inline(always)]
+            fn pack(self) -> Option<$t> {
+                Some(self)
+            }
+            #[inline(always)]
+            fn unpack(slot: $t) -> $t {
+                slot
+            }
+            #[inline(always)]
+            fn pack_all<const N: usize>(off: [$t; N]) -> Option<[$t; N]> {
+                Some(off)
+            }
+        }
+    )*};
+}
+pub(crate) use unpacked;
+unpacked!((), u8);
+
+/// The offsets of a flat torus (`D` lattice coordinates) in one byte: their coordinates
+/// are its digits of `8 / D` bits (0–15 in 2D, 0–3 in 3D). A cell's offsets are translated
+/// so that their least coordinate is 0 in the 1-sheeted torus (a cell is then 0 or 1 on
+/// each axis) and a small representative in a covering, where a few cells reach farther
+/// (see [`Tds`]).
+impl<const D: usize> Packing for [i8; D] {
+    type Slot = u8;
+    #[inline(always)]
+    fn pack(self) -> Option<u8> {
+        // (a negative coordinate has its top bit set)
+        let bits = digit_bits(D);
+        let (mut code, mut all) = (0u8, 0u8);
+        for c in self {
+            all |= c as u8;
+            code = (code << bits) | c as u8;
+        }
+        (all >> bits == 0).then_some(code)
+    }
+    #[inline(always)]
+    fn unpack(slot: u8) -> [i8; D] {
+        let bits = digit_bits(D);
+        let mask = (1u8 << bits) - 1;
+        std::array::from_fn(|c| ((slot >> (bits * (D - 1 - c) as u32)) & mask) as i8)
+    }
+}
+
+/// The bits of a torus offset's coordinate in a slot (see [`Packing`] for `[i8; D]`).
+const fn digit_bits(d: usize) -> u32 {
+    (8 / d) as u32
+}
+
+/// A cell as the code works with it: vertex ids, neighbour ids and the element of each
+/// vertex.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Cell<O, const N: usize> {
     pub v: [VertexId; N],
     pub n: [CellId; N],
     pub off: [O; N],
-    stamp: u32,
 }
 
 impl<O: Copy, const N: usize> Cell<O, N> {
@@ -23,7 +101,6 @@ impl<O: Copy, const N: usize> Cell<O, N> {
             v,
             n: [CellId::NONE; N],
             off,
-            stamp: 0,
         }
     }
 
@@ -42,6 +119,54 @@ impl<O: Copy, const N: usize> Cell<O, N> {
         self.off.swap(a, b);
     }
 
+    /// Index of neighbour `c` in this cell.
+    #[inline]
+    pub fn mirror(&self, c: CellId) -> Option<usize> {
+        first_equal(&self.n, c)
+    }
+}
+
+/// A cell as the store keeps it: vertex ids, neighbour ids, the packed elements (valid
+/// while the store is packed, see [`Tds`]) and a visit stamp (kept in the cell so that a
+/// visit touches one cache line).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Stored<O: Packing, const N: usize> {
+    pub v: [VertexId; N],
+    pub n: [CellId; N],
+    slots: [O::Slot; N],
+    stamp: u32,
+}
+
+impl<O: Packing, const N: usize> Stored<O, N> {
+    /// `cell` packed with stamp 0, if each of its elements fits in a slot.
+    #[inline(always)]
+    pub fn pack(cell: &Cell<O, N>) -> Option<Self> {
+        Some(Stored {
+            v: cell.v,
+            n: cell.n,
+            slots: O::pack_all(cell.off)?,
+            stamp: 0,
+        })
+    }
+
+    /// The elements of the slots (those of the cell while the store is packed).
+    #[inline(always)]
+    pub fn packed_offsets(&self) -> [O; N] {
+        self.slots.map(O::unpack)
+    }
+
+    /// Index of vertex `x` in this cell.
+    #[inline]
+    pub fn index_of(&self, x: VertexId) -> Option<usize> {
+        first_equal(&self.v, x)
+    }
+
+    /// Index of neighbour `c` in this cell.
+    #[inline]
+    pub fn mirror(&self, c: CellId) -> Option<usize> {
+        first_equal(&self.n, c)
+    }
+
     /// The cell's stamp: the mark of a visit, or during a parallel pass its owner.
     #[inline]
     pub fn stamp(&self) -> u32 {
@@ -52,12 +177,6 @@ impl<O: Copy, const N: usize> Cell<O, N> {
     #[inline]
     pub fn set_stamp(&mut self, s: u32) {
         self.stamp = s;
-    }
-
-    /// Index of neighbour `c` in this cell.
-    #[inline]
-    pub fn mirror(&self, c: CellId) -> Option<usize> {
-        first_equal(&self.n, c)
     }
 }
 
@@ -81,7 +200,7 @@ pub fn replaced<T: Copy, const N: usize>(a: [T; N], i: usize, x: T) -> [T; N] {
 }
 
 /// Asks the processor to start loading `x` into its caches, every line it spans (a
-/// 48-byte cell straddles two lines one time in two): a hint, nothing on other
+/// 40-byte cell straddles two lines one time in two): a hint, nothing on other
 /// architectures.
 #[inline(always)]
 pub fn prefetch<T>(x: &T) {
@@ -108,36 +227,148 @@ pub fn prefetch<T>(x: &T) {
     let _ = x;
 }
 
-/// Cell storage with a free list and visit stamps.
-#[derive(Clone, Debug, Default)]
-pub struct Tds<O, const N: usize> {
-    pub cells: Vec<Cell<O, N>>,
+/// Cell storage with a free list and visit stamps. The store is **packed** while every
+/// cell's elements fit in their slots ([`Packing`]); the first cell whose do not turns it
+/// **wide**: from then on every cell's elements are kept beside the cells, by cell id,
+/// until the store is emptied. (The 1-sheeted tori stay packed; a covering's larger
+/// offsets can make it wide, 12 bytes a cell more.)
+#[derive(Clone, Debug)]
+pub struct Tds<O: Packing, const N: usize> {
+    pub cells: Vec<Stored<O, N>>,
+    /// Wide: the elements of each cell slot (`None` while packed).
+    wide: Option<Vec<[O; N]>>,
     free: Vec<CellId>,
     generation: u32,
 }
 
-impl<O: Copy, const N: usize> Tds<O, N> {
+impl<O: Packing, const N: usize> Default for Tds<O, N> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<O: Packing, const N: usize> Tds<O, N> {
     /// An empty complex.
     pub fn new() -> Self {
         Tds {
             cells: Vec::new(),
+            wide: None,
             free: Vec::new(),
             generation: 0,
         }
     }
 
+    /// True while every cell's elements are in its slots.
+    #[inline(always)]
+    pub fn is_packed(&self) -> bool {
+        self.wide.is_none()
+    }
+
+    /// The elements of cell `c`.
+    #[inline(always)]
+    pub fn off(&self, c: CellId) -> [O; N] {
+        match &self.wide {
+            None => self.cells[c.index()].packed_offsets(),
+            Some(wide) => wide[c.index()],
+        }
+    }
+
+    /// True when every element of cell `c` is `o` (compared packed, where they are).
+    #[inline(always)]
+    pub fn all_are(&self, c: CellId, o: O) -> bool
+    where
+        O: PartialEq,
+    {
+        match (&self.wide, o.pack()) {
+            (None, Some(s)) => self.cells[c.index()].slots == [s; N],
+            (None, None) => false,
+            (Some(wide), _) => wide[c.index()] == [o; N],
+        }
+    }
+
+    /// The element of vertex `i` of cell `c`.
+    #[inline(always)]
+    pub fn off_at(&self, c: CellId, i: usize) -> O {
+        match &self.wide {
+            None => O::unpack(self.cells[c.index()].slots[i]),
+            Some(wide) => wide[c.index()][i],
+        }
+    }
+
+    /// Cell `c` (a copy).
+    #[inline(always)]
+    pub fn cell(&self, c: CellId) -> Cell<O, N> {
+        let s = &self.cells[c.index()];
+        Cell {
+            v: s.v,
+            n: s.n,
+            off: self.off(c),
+        }
+    }
+
+    /// Overwrites slot `c` with `cell`, its stamp kept.
+    #[inline(always)]
+    pub fn put(&mut self, c: CellId, cell: &Cell<O, N>) {
+        match O::pack_all(cell.off) {
+            Some(slots) if self.is_packed() => {
+                // (the fields only: the stamp is not read)
+                let slot = &mut self.cells[c.index()];
+                (slot.v, slot.slots, slot.n) = (cell.v, slots, cell.n);
+            }
+            _ => self.put_wide(c, cell),
+        }
+    }
+
+    /// [`Self::put`] into a wide store, or one that a cell turns wide.
+    #[cold]
+    fn put_wide(&mut self, c: CellId, cell: &Cell<O, N>) {
+        let wide = self.widen();
+        wide[c.index()] = cell.off;
+        let slot = &mut self.cells[c.index()];
+        (slot.v, slot.n) = (cell.v, cell.n);
+    }
+
+    /// Sets the elements of cell `c`.
+    pub fn set_off(&mut self, c: CellId, off: [O; N]) {
+        let cell = Cell {
+            off,
+            ..self.cell(c)
+        };
+        self.put(c, &cell);
+    }
+
+    /// Turns the store wide (see [`Tds`]) if it is not, and returns the elements beside.
+    #[cold]
+    fn widen(&mut self) -> &mut Vec<[O; N]> {
+        self.wide
+            .get_or_insert_with(|| self.cells.iter().map(Stored::packed_offsets).collect())
+    }
+
     /// Adds a cell, reusing a free slot when there is one.
-    #[inline]
+    #[inline(always)]
     pub fn create(&mut self, c: Cell<O, N>) -> CellId {
         if let Some(id) = self.free.pop() {
             // keep the old stamp: it belongs to an earlier visit
-            let stamp = self.cells[id.index()].stamp;
-            self.cells[id.index()] = Cell { stamp, ..c };
-            id
-        } else {
-            self.cells.push(c);
-            CellId::new(self.cells.len() - 1)
+            self.put(id, &c);
+            return id;
         }
+        let id = CellId::new(self.cells.len());
+        match Stored::pack(&c) {
+            Some(p) if self.is_packed() => self.cells.push(p),
+            _ => {
+                self.cells.push(Stored {
+                    v: c.v,
+                    n: c.n,
+                    slots: [O::Slot::default(); N],
+                    stamp: 0,
+                });
+                // (widened now: the new slot is among those read; wide already: one more)
+                let wide = self.widen();
+                wide.resize(id.index() + 1, c.off);
+                wide[id.index()] = c.off;
+            }
+        }
+        id
     }
 
     /// Removes a cell (its slot goes to the free list).
@@ -147,14 +378,15 @@ impl<O: Copy, const N: usize> Tds<O, N> {
         self.free.push(id);
     }
 
-    /// Grows the store to `len` slots, each new one a copy of `dead`, written on rayon's
-    /// threads: fresh memory is first touched there (a parallel pass reserves its new
-    /// cells' slots at once, 3.4 million of them in the last wave of 10⁶ points in a cube,
-    /// 0.1 s on one thread).
-    pub fn grow(&mut self, len: usize, dead: Cell<O, N>)
+    /// Grows the packed store to `len` slots, each new one a copy of `dead` (whose
+    /// elements must pack), written on rayon's threads: fresh memory is first touched
+    /// there (a parallel pass reserves its new cells' slots at once, 3.4 million of them in
+    /// the last wave of 10⁶ points in a cube, 0.1 s on one thread).
+    pub fn grow(&mut self, len: usize, dead: Stored<O, N>)
     where
         O: Send + Sync,
     {
+        debug_assert!(self.is_packed());
         let more = len.saturating_sub(self.cells.len());
         self.cells.reserve(more);
         self.cells.spare_capacity_mut()[..more]
@@ -238,15 +470,19 @@ impl<O: Copy, const N: usize> Tds<O, N> {
         self.cells[id.index()].stamp = s;
     }
 
-    /// Drops every cell.
+    /// Drops every cell (the store is packed again).
     pub fn clear(&mut self) {
         self.cells.clear();
+        self.wide = None;
         self.free.clear();
     }
 
     /// Reserves room for `n` more cells.
     pub fn reserve(&mut self, n: usize) {
         self.cells.reserve(n);
+        if let Some(wide) = &mut self.wide {
+            wide.reserve(n);
+        }
     }
 }
 
@@ -255,8 +491,75 @@ mod tests {
     use super::*;
 
     #[test]
-    fn typed_ids_keep_a_cell_in_48_bytes() {
-        assert_eq!(std::mem::size_of::<Cell<[i8; 3], 4>>(), 48);
+    fn packed_offsets_keep_a_torus_cell_in_40_bytes_and_a_triangle_in_32() {
+        assert_eq!(std::mem::size_of::<Stored<[i8; 3], 4>>(), 40);
+        assert_eq!(std::mem::size_of::<Stored<[i8; 2], 3>>(), 32);
+        assert_eq!(std::mem::size_of::<Stored<(), 3>>(), 28);
+    }
+
+    #[test]
+    fn offsets_pack_exactly_within_their_digits() {
+        assert_eq!((digit_bits(2), digit_bits(3)), (4, 2));
+        for x in -2..20i8 {
+            for y in -2..20i8 {
+                let fits = (0..16).contains(&x) && (0..16).contains(&y);
+                let slot = [x, y].pack();
+                assert_eq!(slot.is_some(), fits, "{x} {y}");
+                if let Some(s) = slot {
+                    assert_eq!(<[i8; 2]>::unpack(s), [x, y]);
+                }
+                for z in -1..8i8 {
+                    let fits = [x, y, z].iter().all(|c| (0..4).contains(c));
+                    let slot = [x, y, z].pack();
+                    assert_eq!(slot.is_some(), fits, "{x} {y} {z}");
+                    if let Some(s) = slot {
+                        assert_eq!(<[i8; 3]>::unpack(s), [x, y, z]);
+                    }
+                }
+            }
+        }
+        // every slot value is one offset
+        let all: std::collections::BTreeSet<_> = (0..64u8).map(<[i8; 3]>::unpack).collect();
+        assert_eq!(all.len(), 64);
+        let all: std::collections::BTreeSet<_> = (0..=255u8).map(<[i8; 2]>::unpack).collect();
+        assert_eq!(all.len(), 256);
+    }
+
+    #[test]
+    fn a_cell_that_does_not_pack_turns_the_store_wide_and_keeps_every_offset() {
+        let mut tds: Tds<[i8; 3], 4> = Tds::new();
+        let vs = |v: [u32; 4]| v.map(VertexId);
+        let small = [[0, 0, 0], [1, 0, 0], [0, 1, 1], [3, 3, 3]];
+        let a = tds.create(Cell::new(vs([0, 1, 2, 3]), small));
+        let b = tds.create(Cell::new(vs([1, 2, 3, 4]), [[0, 0, 0]; 4]));
+        assert!(tds.is_packed());
+        assert_eq!(tds.off(a), small);
+        tds.set_stamp(a, 9);
+        // a covering's offset beyond the digits, and a negative one
+        let large = [[0, 0, 0], [4, 0, 0], [0, 1, 7], [2, 0, 1]];
+        let c = tds.create(Cell::new(vs([2, 3, 4, 5]), large));
+        assert!(!tds.is_packed());
+        assert_eq!(
+            (tds.off(a), tds.off(b), tds.off(c)),
+            (small, [[0, 0, 0]; 4], large)
+        );
+        assert_eq!(tds.off_at(c, 2), [0, 1, 7]);
+        let negative = [[-1, 0, 0], [0, 0, 0], [0, 0, 0], [0, 0, 0]];
+        tds.set_off(b, negative);
+        assert_eq!(tds.off(b), negative);
+        // rewriting keeps the stamp; a freed slot reused keeps its own elements
+        tds.put(a, &Cell::new(vs([7, 8, 9, 10]), large));
+        assert_eq!(
+            (tds.cell(a).v, tds.off(a), tds.stamp(a)),
+            (vs([7, 8, 9, 10]), large, 9)
+        );
+        tds.delete(c);
+        let d = tds.create(Cell::new(vs([3, 4, 5, 6]), small));
+        assert_eq!((d, tds.off(d)), (c, small));
+        // emptied, the store packs again
+        tds.clear();
+        tds.create(Cell::new(vs([0, 1, 2, 3]), small));
+        assert!(tds.is_packed());
     }
 
     #[test]
@@ -264,13 +567,13 @@ mod tests {
         let mut tds: Tds<u8, 3> = Tds::new();
         let live = Cell::new([1, 2, 3].map(VertexId), [0; 3]);
         let a = tds.create(live);
-        let dead = Cell::new([VertexId::NONE; 3], [7; 3]);
+        let dead = Stored::pack(&Cell::new([VertexId::NONE; 3], [7; 3])).unwrap();
         // more slots than one of the parallel writers' pieces
         tds.grow(40_000, dead);
         assert_eq!(tds.cells.len(), 40_000);
-        assert_eq!(tds.cells[a.index()], live);
+        assert_eq!(tds.cell(a), live);
         assert!(tds.cells[1..].iter().all(|&c| c == dead));
-        tds.grow(10, live);
+        tds.grow(10, Stored::pack(&live).unwrap());
         assert_eq!(tds.cells.len(), 40_000);
     }
 

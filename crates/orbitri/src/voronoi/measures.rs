@@ -170,7 +170,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         let n = self.number_of_vertices();
         if k + 2 < n {
             for &t in star_of(k + 2) {
-                prefetch(e.cell(t));
+                e.prefetch_cell(t);
             }
         }
         if k + 1 < n {
