@@ -74,11 +74,27 @@ impl<const D: usize> Packing for [i8; D] {
     }
     #[inline(always)]
     fn unpack(slot: u8) -> [i8; D] {
+        if D == 3 {
+            // (3D, the conflict search's: one load, where the shifts cost 1 % of a build)
+            let t = &OFFSETS_3[usize::from(slot & 63)];
+            return std::array::from_fn(|c| t[c]);
+        }
         let bits = digit_bits(D);
         let mask = (1u8 << bits) - 1;
         std::array::from_fn(|c| ((slot >> (bits * (D - 1 - c) as u32)) & mask) as i8)
     }
 }
+
+/// The 3D slots' offsets.
+static OFFSETS_3: [[i8; 3]; 64] = {
+    let mut table = [[0i8; 3]; 64];
+    let mut code = 0;
+    while code < 64 {
+        table[code] = [(code >> 4) as i8, ((code >> 2) & 3) as i8, (code & 3) as i8];
+        code += 1;
+    }
+    table
+};
 
 /// The bits of a torus offset's coordinate in a slot (see [`Packing`] for `[i8; D]`).
 const fn digit_bits(d: usize) -> u32 {
