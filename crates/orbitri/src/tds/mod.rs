@@ -394,15 +394,17 @@ impl<O: Packing, const N: usize> Tds<O, N> {
         self.free.push(id);
     }
 
-    /// Grows the packed store to `len` slots, each new one a copy of `dead` (whose
-    /// elements must pack), written on rayon's threads: fresh memory is first touched
-    /// there (a parallel pass reserves its new cells' slots at once, 3.4 million of them in
-    /// the last wave of 10⁶ points in a cube, 0.1 s on one thread).
+    /// Grows the store to `len` slots, each new one a copy of `dead` (its elements those
+    /// of its slots), written on rayon's threads: fresh memory is first touched there (a
+    /// parallel pass, on a packed store, reserves its new cells' slots at once, 3.4 million
+    /// of them in the last wave of 10⁶ points in a cube, 0.1 s on one thread).
     pub fn grow(&mut self, len: usize, dead: Stored<O, N>)
     where
         O: Send + Sync,
     {
-        debug_assert!(self.is_packed());
+        if let Some(wide) = &mut self.wide {
+            wide.resize(len.max(wide.len()), dead.packed_offsets());
+        }
         let more = len.saturating_sub(self.cells.len());
         self.cells.reserve(more);
         self.cells.spare_capacity_mut()[..more]
@@ -572,6 +574,12 @@ mod tests {
         tds.delete(c);
         let d = tds.create(Cell::new(vs([3, 4, 5, 6]), small));
         assert_eq!((d, tds.off(d)), (c, small));
+        // grown while wide, the new slots' elements are the dead cell's
+        let dead = Stored::pack(&Cell::new([VertexId::NONE; 4], [[1, 0, 0]; 4])).unwrap();
+        tds.grow(10, dead);
+        assert_eq!(tds.cells.len(), 10);
+        assert_eq!(tds.off(CellId::new(9)), [[1, 0, 0]; 4]);
+        assert_eq!(tds.off(c), small);
         // emptied, the store packs again
         tds.clear();
         tds.create(Cell::new(vs([0, 1, 2, 3]), small));
