@@ -43,22 +43,7 @@ impl<const D: usize> Default for Motion<D> {
     }
 }
 
-/// Stored as they are.
-impl<const D: usize> crate::tds::Packing for Motion<D> {
-    type Slot = Self;
-    #[inline(always)]
-    fn pack(self) -> Option<Self> {
-        Some(self)
-    }
-    #[inline(always)]
-    fn unpack(slot: Self) -> Self {
-        slot
-    }
-    #[inline(always)]
-    fn pack_all<const N: usize>(off: [Self; N]) -> Option<[Self; N]> {
-        Some(off)
-    }
-}
+crate::tds::unpacked!(impl [const D: usize] Motion<D>);
 
 /// A coset representative `x ↦ A·x + s·M/q` as given to [`FlatManifold::new`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

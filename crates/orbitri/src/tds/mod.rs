@@ -33,8 +33,8 @@ pub trait Packing: Copy {
 
 /// Elements stored as they are.
 macro_rules! unpacked {
-    ($($t:ty),*) => {$(
-        impl $crate::tds::Packing for $t {
+    (impl [$($g:tt)*] $t:ty) => {
+        impl<$($g)*> $crate::tds::Packing for $t {
             type Slot = $t;
             #[inline(always)]
             fn pack(self) -> Option<$t> {
@@ -49,6 +49,9 @@ macro_rules! unpacked {
                 Some(off)
             }
         }
+    };
+    ($($t:ty),*) => {$(
+        $crate::tds::unpacked!(impl [] $t);
     )*};
 }
 pub(crate) use unpacked;
