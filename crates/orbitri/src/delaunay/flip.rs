@@ -39,9 +39,10 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         let old = self.tds.cell(c);
         // (two more slots; guaranteed, so no criterion bookkeeping)
         let (b, d) = (self.tds.create(old), self.tds.create(old));
-        for (id, t) in [c, b, d].into_iter().zip(split(&old, x, qo, [c, b, d])) {
-            self.rewrite(id, t);
-        }
+        let [tc, tb, td] = split(&old, x, qo, [c, b, d]);
+        self.rewrite(c, tc);
+        self.rewrite(b, tb);
+        self.rewrite(d, td);
         self.relink(b, 0, old.n[1], c);
         self.relink(d, 0, old.n[2], c);
         self.vcell[old.v[0].index()] = b;
@@ -106,7 +107,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     #[inline(always)]
     fn rewrite(&mut self, c: CellId, t: Triangle<S::Elem>) {
         let cell = self.canonical_triangle(t);
-        self.tds.put(c, &cell);
+        self.tds.put(c, cell);
     }
 
     /// Links facet `i` of `a` with the facet of `d` that was linked to `old`.

@@ -552,7 +552,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 let mut cell = self.tds.cell(c);
                 cell.off[k] = self.space.compose(cell.off[k], t);
                 self.canonicalize(&mut cell);
-                self.tds.put(c, &cell);
+                self.tds.put(c, cell);
             }
         }
         self.points[p.index()] = coords;

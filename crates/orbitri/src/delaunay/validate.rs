@@ -130,7 +130,7 @@ mod tests {
         let c = e.tds.ids().next().unwrap();
         let mut cell = e.tds.cell(c);
         cell.swap_slots(0, 1);
-        e.tds.put(c, &cell);
+        e.tds.put(c, cell);
         let msg = e.is_valid().unwrap_err().0;
         assert!(msg.contains("not positively oriented"), "{msg}");
     }

@@ -77,27 +77,33 @@ impl<const D: usize> Packing for [i8; D] {
     }
     #[inline(always)]
     fn unpack(slot: u8) -> [i8; D] {
-        if D == 3 {
-            // (3D, the conflict search's: one load, where the shifts cost 1 % of a build)
-            let t = &OFFSETS_3[usize::from(slot & 63)];
-            return std::array::from_fn(|c| t[c]);
-        }
-        let bits = digit_bits(D);
-        let mask = (1u8 << bits) - 1;
-        std::array::from_fn(|c| ((slot >> (bits * (D - 1 - c) as u32)) & mask) as i8)
+        // (one load from a table, where shifting the digits out and gathering them into
+        // an array cost 1 % of a 3D build and more of a 2D one)
+        let table: &'static [[i8; D]; 256] = &Digits::<D>::OFFSETS;
+        table[usize::from(slot)]
     }
 }
 
-/// The 3D slots' offsets.
-static OFFSETS_3: [[i8; 3]; 64] = {
-    let mut table = [[0i8; 3]; 64];
-    let mut code = 0;
-    while code < 64 {
-        table[code] = [(code >> 4) as i8, ((code >> 2) & 3) as i8, (code & 3) as i8];
-        code += 1;
-    }
-    table
-};
+/// The digits of every slot of a `D`-dimensional torus offset (see [`Packing`]).
+struct Digits<const D: usize>;
+
+impl<const D: usize> Digits<D> {
+    const OFFSETS: [[i8; D]; 256] = {
+        let bits = digit_bits(D);
+        let mask = (1u32 << bits) - 1;
+        let mut table = [[0i8; D]; 256];
+        let mut code = 0;
+        while code < 256 {
+            let mut c = 0;
+            while c < D {
+                table[code][c] = ((code as u32 >> (bits * (D - 1 - c) as u32)) & mask) as i8;
+                c += 1;
+            }
+            code += 1;
+        }
+        table
+    };
+}
 
 /// The bits of a torus offset's coordinate in a slot (see [`Packing`] for `[i8; D]`).
 const fn digit_bits(d: usize) -> u32 {
@@ -327,24 +333,22 @@ impl<O: Packing, const N: usize> Tds<O, N> {
 
     /// Overwrites slot `c` with `cell`, its stamp kept.
     #[inline(always)]
-    pub fn put(&mut self, c: CellId, cell: &Cell<O, N>) {
+    pub fn put(&mut self, c: CellId, cell: Cell<O, N>) {
+        // (the fields only: the stamp is not read)
+        let slot = &mut self.cells[c.index()];
+        (slot.v, slot.n) = (cell.v, cell.n);
         match O::pack_all(cell.off) {
-            Some(slots) if self.is_packed() => {
-                // (the fields only: the stamp is not read)
-                let slot = &mut self.cells[c.index()];
-                (slot.v, slot.slots, slot.n) = (cell.v, slots, cell.n);
-            }
-            _ => self.put_wide(c, cell),
+            Some(slots) if self.wide.is_none() => self.cells[c.index()].slots = slots,
+            // (the elements alone go out of line, so that the cell need not be built in
+            // memory for the call: reading it back whole stalls on its narrower writes)
+            _ => self.put_wide(c, cell.off),
         }
     }
 
-    /// [`Self::put`] into a wide store, or one that a cell turns wide.
+    /// Sets the elements of cell `c` in a wide store, or one that they turn wide.
     #[cold]
-    fn put_wide(&mut self, c: CellId, cell: &Cell<O, N>) {
-        let wide = self.widen();
-        wide[c.index()] = cell.off;
-        let slot = &mut self.cells[c.index()];
-        (slot.v, slot.n) = (cell.v, cell.n);
+    fn put_wide(&mut self, c: CellId, off: [O; N]) {
+        self.widen()[c.index()] = off;
     }
 
     /// Sets the elements of cell `c`.
@@ -353,7 +357,7 @@ impl<O: Packing, const N: usize> Tds<O, N> {
             off,
             ..self.cell(c)
         };
-        self.put(c, &cell);
+        self.put(c, cell);
     }
 
     /// Turns the store wide (see [`Tds`]) if it is not, and returns the elements beside.
@@ -368,7 +372,7 @@ impl<O: Packing, const N: usize> Tds<O, N> {
     pub fn create(&mut self, c: Cell<O, N>) -> CellId {
         if let Some(id) = self.free.pop() {
             // keep the old stamp: it belongs to an earlier visit
-            self.put(id, &c);
+            self.put(id, c);
             return id;
         }
         let id = CellId::new(self.cells.len());
@@ -569,7 +573,7 @@ mod tests {
         tds.set_off(b, negative);
         assert_eq!(tds.off(b), negative);
         // rewriting keeps the stamp; a freed slot reused keeps its own elements
-        tds.put(a, &Cell::new(vs([7, 8, 9, 10]), large));
+        tds.put(a, Cell::new(vs([7, 8, 9, 10]), large));
         assert_eq!(
             (tds.cell(a).v, tds.off(a), tds.stamp(a)),
             (vs([7, 8, 9, 10]), large, 9)
