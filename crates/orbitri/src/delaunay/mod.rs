@@ -440,6 +440,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     }
 
     /// A stored cell (a copy).
+    #[inline(always)]
     pub fn cell(&self, c: CellId) -> Cell<S::Elem, N> {
         self.tds.cell(c)
     }
@@ -450,7 +451,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     }
 
     /// The lifted vertex `i` of cell `c`.
-    #[inline]
+    #[inline(always)]
     pub fn lifted(&self, c: CellId, i: usize) -> LiftedOf<S, N> {
         let cell = &self.tds.cells[c.index()];
         (

@@ -790,6 +790,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
 
     /// The Delaunay edge of cell `c` from its slot `k` to its slot `j`: the far vertex and
     /// its element relative to the near one's.
+    #[inline(always)]
     fn edge_at(&self, c: CellId, k: usize, j: usize) -> (VertexId, S::Elem) {
         let cell = self.engine().cell(c);
         (cell.v[j], self.space().relative(cell.off[j], cell.off[k]))
