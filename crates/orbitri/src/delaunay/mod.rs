@@ -445,6 +445,12 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.tds.cell(c)
     }
 
+    /// The vertices of cell `c` (its elements not decoded).
+    #[inline(always)]
+    pub(crate) fn vertices(&self, c: CellId) -> [VertexId; N] {
+        self.tds.cells[c.index()].v
+    }
+
     /// The point of a vertex.
     pub fn point_of(&self, v: VertexId) -> PointId {
         self.vpoint[v.index()]

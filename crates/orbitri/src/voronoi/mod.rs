@@ -629,7 +629,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             if k % CELLS_PER_POLL == 0 && interrupt() {
                 return Err(Error::Interrupted);
             }
-            for &v in &e.cell(c).v {
+            for v in e.vertices(c) {
                 start[v.index() + 1] += 1;
             }
         }
@@ -639,7 +639,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         let mut fill = start.clone();
         let mut incident = vec![CellId(0); start[vertices] as usize];
         for &c in ids {
-            for &v in &e.cell(c).v {
+            for v in e.vertices(c) {
                 incident[fill[v.index()] as usize] = c;
                 fill[v.index()] += 1;
             }
