@@ -334,14 +334,15 @@ impl<O: Packing, const N: usize> Tds<O, N> {
     /// Overwrites slot `c` with `cell`, its stamp kept.
     #[inline(always)]
     pub fn put(&mut self, c: CellId, cell: Cell<O, N>) {
+        let packed = O::pack_all(cell.off).filter(|_| self.is_packed());
         // (the fields only: the stamp is not read)
         let slot = &mut self.cells[c.index()];
         (slot.v, slot.n) = (cell.v, cell.n);
-        match O::pack_all(cell.off) {
-            Some(slots) if self.wide.is_none() => self.cells[c.index()].slots = slots,
+        match packed {
+            Some(slots) => slot.slots = slots,
             // (the elements alone go out of line, so that the cell need not be built in
             // memory for the call: reading it back whole stalls on its narrower writes)
-            _ => self.put_wide(c, cell.off),
+            None => self.put_wide(c, cell.off),
         }
     }
 
