@@ -147,12 +147,18 @@ impl<E, const N: usize> Default for Faces<E, N> {
 }
 
 impl<E: Copy + PartialEq, const N: usize> Faces<E, N> {
-    /// Lists the Delaunay edges of a `star` (`edge(cell, k, j)`: from the point at slot `k`
-    /// to slot `j`), in the order of first appearance, each found again by hashing.
+    /// Lists the Delaunay edges of a `star` (`element(cell, k, j)`: of the edge from the
+    /// point at slot `k` to slot `j`, the far vertex's element), in the order of first
+    /// appearance, each found again by hashing its far vertex. With `simplicial` (the
+    /// triangulation is a simplicial complex: two vertices share at most one edge) the far
+    /// vertex alone names an edge, and its element is computed once, when the edge is first
+    /// seen; otherwise a far vertex seen before is the same edge only with the same element.
     fn gather(
         &mut self,
         star: &[(CellId, u8)],
-        edge: impl Fn(CellId, usize, usize) -> (VertexId, E),
+        simplicial: bool,
+        vertices: impl Fn(CellId) -> [VertexId; N],
+        element: impl Fn(CellId, usize, usize) -> E,
     ) {
         self.edges.clear();
         self.index.clear();
@@ -162,25 +168,29 @@ impl<E: Copy + PartialEq, const N: usize> Faces<E, N> {
         self.table.resize(size, u32::MAX);
         for &(t, k) in star {
             let k = k as usize;
-            let mut at = [0u32; N];
+            let vs = vertices(t);
+            // (written in place: an array built on the stack and pushed whole is read back
+            // in one load from several stores, a store-forwarding stall)
+            let u = self.index.len();
+            self.index.push([0; N]);
             for j in slots_but::<N>(k) {
-                let (v, g) = edge(t, k, j);
+                let v = vs[j];
                 let mut h = (v.0.wrapping_mul(0x9E37_79B1) >> 7) as usize & (size - 1);
-                at[j] = loop {
+                self.index[u][j] = loop {
                     let f = self.table[h];
                     if f == u32::MAX {
                         self.table[h] = self.edges.len() as u32;
-                        self.edges.push((v, g, 0.0));
+                        self.edges.push((v, element(t, k, j), 0.0));
                         break self.table[h];
                     }
                     let x = &self.edges[f as usize];
-                    if (x.0, x.1) == (v, g) {
+                    if x.0 == v && (simplicial || x.1 == element(t, k, j)) {
+                        debug_assert!(x.1 == element(t, k, j), "one edge between two vertices");
                         break f;
                     }
                     h = (h + 1) & (size - 1);
                 };
             }
-            self.index.push(at);
         }
     }
 }
@@ -721,7 +731,12 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             vertex_of_root[r]
         }));
         // faces: the ring of star cells around each Delaunay edge at the point
-        edges.gather(star, |c, k, j| self.edge_at(c, k, j));
+        edges.gather(
+            star,
+            e.sheets() == 1,
+            |c| e.vertices(c),
+            |c, k, j| self.edge_at(c, k, j).1,
+        );
         member.clear();
         for (s, at) in edges.index.iter().enumerate() {
             let k = star[s].1 as usize;
