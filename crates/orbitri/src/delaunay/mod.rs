@@ -451,6 +451,12 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.tds.cells[c.index()].v
     }
 
+    /// The element of vertex `i` of cell `c` (the other slots not decoded).
+    #[inline(always)]
+    pub(crate) fn element(&self, c: CellId, i: usize) -> S::Elem {
+        self.tds.off_at(c, i)
+    }
+
     /// The point of a vertex.
     pub fn point_of(&self, v: VertexId) -> PointId {
         self.vpoint[v.index()]

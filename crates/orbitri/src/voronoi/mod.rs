@@ -807,8 +807,9 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     /// its element relative to the near one's.
     #[inline(always)]
     fn edge_at(&self, c: CellId, k: usize, j: usize) -> (VertexId, S::Elem) {
-        let cell = self.engine().cell(c);
-        (cell.v[j], self.space().relative(cell.off[j], cell.off[k]))
+        let e = self.engine();
+        let g = self.space().relative(e.element(c, j), e.element(c, k));
+        (e.vertices(c)[j], g)
     }
 
     /// The star cells around the Delaunay edge from the point to `(w, r)`, in cyclic order:
