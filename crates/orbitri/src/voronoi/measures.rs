@@ -233,11 +233,8 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
                 }
                 // the neighbour's circumcenter, carried into this cell's frame
                 let g = e.translation(t, l, d);
-                let dc = e.cell(d);
-                let d0 = (
-                    e.points()[e.point_of(dc.v[0]).index()],
-                    space.compose(g, dc.off[0]),
-                );
+                let (q, off) = e.lifted(d, 0);
+                let d0 = (q, space.compose(g, off));
                 let base = space.lifted_difference(d0, at);
                 let z = space.untwist(space.inverse(g), center[d.index()]);
                 let c2: [f64; D] = std::array::from_fn(|x| base[x] + z[x]);
