@@ -451,6 +451,12 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.tds.cells[c.index()].v
     }
 
+    /// The neighbours of cell `c` (its elements not decoded).
+    #[inline(always)]
+    pub(crate) fn adjacent(&self, c: CellId) -> [CellId; N] {
+        self.tds.cells[c.index()].n
+    }
+
     /// The element of vertex `i` of cell `c` (the other slots not decoded).
     #[inline(always)]
     pub(crate) fn element(&self, c: CellId, i: usize) -> S::Elem {

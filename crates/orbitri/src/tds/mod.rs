@@ -209,7 +209,7 @@ impl<O: Packing, const N: usize> Stored<O, N> {
 /// compiler makes it one vector comparison, where a search stopping at the first match
 /// mispredicts a branch about once a call (the slot is as good as random).
 #[inline(always)]
-fn first_equal<T: PartialEq + Copy, const N: usize>(a: &[T; N], x: T) -> Option<usize> {
+pub(crate) fn first_equal<T: PartialEq + Copy, const N: usize>(a: &[T; N], x: T) -> Option<usize> {
     let mut mask = 0u32;
     for (k, &y) in a.iter().enumerate() {
         mask |= u32::from(y == x) << k;

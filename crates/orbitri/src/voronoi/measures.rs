@@ -210,7 +210,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         let mut moment = [0.0; D];
         for (u, &(t, k)) in star.iter().enumerate() {
             let k = k as usize;
-            let cell = e.cell(t);
+            let (vs, ns) = (e.vertices(t), e.adjacent(t));
             let at = e.lifted(t, k);
             // the cell's vertices and circumcenter in its frame, relative to the point
             let rel: [[f64; D]; N] = std::array::from_fn(|a| {
@@ -227,7 +227,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             let extent2 = rel.iter().map(|r| dot(r, r)).fold(0.0, f64::max);
             let mut piece_moment = [0.0; D];
             for l in slots_but::<N>(k) {
-                let d = cell.n[l];
+                let d = ns[l];
                 if d < t {
                     continue; // taken from `d`
                 }
@@ -253,7 +253,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
                     if N == 4 {
                         // the foot of the bisector (power bisector) on the edge
                         let lambda = if e.is_weighted() {
-                            let w = |a: usize| e.vertex_weight(cell.v[a]);
+                            let w = |a: usize| e.vertex_weight(vs[a]);
                             0.5 + (w(k) - w(j)) / (2.0 * bb)
                         } else {
                             0.5

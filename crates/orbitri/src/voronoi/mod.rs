@@ -20,6 +20,7 @@ use rayon::prelude::*;
 use crate::error::{Error, Result};
 use crate::ids::{CellId, InputId, PointId, VertexId};
 use crate::space::FlatSpace;
+use crate::tds::first_equal;
 use crate::triangulation::Triangulation;
 
 /// A face of a Voronoi cell: the part of the bisector with one periodic image of a neighbour.
@@ -663,10 +664,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         let e = self.engine();
         out.clear();
         out.extend(stars.of(v).iter().map(|&c| {
-            let k = e
-                .cell(c)
-                .index_of(v)
-                .expect("a cell of a star holds its vertex");
+            let k = first_equal(&e.vertices(c), v).expect("a cell of a star holds its vertex");
             (c, k as u8)
         }));
     }
