@@ -198,12 +198,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         let (mut faces, list) = pairs.unzip();
         if let Some(faces) = faces.as_deref_mut() {
             // the faces in the order the whole cell lists them: by first appearance in the star
-            faces.gather(
-                star,
-                true,
-                |t| e.vertices(t),
-                |t, k, j| self.edge_at(t, k, j).1,
-            );
+            self.gather_edges(faces, star);
         }
         let mut volume = 0.0;
         let mut surface = 0.0;

@@ -729,12 +729,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             vertex_of_root[r]
         }));
         // faces: the ring of star cells around each Delaunay edge at the point
-        edges.gather(
-            star,
-            e.sheets() == 1,
-            |c| e.vertices(c),
-            |c, k, j| self.edge_at(c, k, j).1,
-        );
+        self.gather_edges(edges, star);
         member.clear();
         for (s, at) in edges.index.iter().enumerate() {
             let k = star[s].1 as usize;
@@ -799,6 +794,18 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             volume: space.measure_to_user(volume, D as i32),
             centroid: around(&centroid_rel),
         }
+    }
+
+    /// Lists the Delaunay edges of a `star` into `faces` ([`Faces::gather`]): by far vertex
+    /// alone once the triangulation is 1-sheeted (a simplicial complex).
+    fn gather_edges(&self, faces: &mut Faces<S::Elem, N>, star: &[(CellId, u8)]) {
+        let e = self.engine();
+        faces.gather(
+            star,
+            e.sheets() == 1,
+            |c| e.vertices(c),
+            |c, k, j| self.edge_at(c, k, j).1,
+        );
     }
 
     /// The Delaunay edge of cell `c` from its slot `k` to its slot `j`: the far vertex and
