@@ -12,25 +12,28 @@
 use rayon::prelude::*;
 
 use super::{
-    cross, dot, listed_once, slots_but, slots_but_two, CellMeasures, Faces, Neighbor, Stars,
-    POINTS_PER_POLL,
+    cross, dot, listed_once, slots_but, slots_but_two, CellMeasures, Faces, Stars, POINTS_PER_POLL,
 };
 use crate::error::{Error, Result};
-use crate::ids::{CellId, PointId};
+use crate::ids::{CellId, InputId, PointId};
 use crate::space::FlatSpace;
 use crate::tds::prefetch;
 use crate::triangulation::Triangulation;
 
+/// A neighbour pair as its block keeps it: `j`, the shift and the area (`i` is the point
+/// whose pairs these are; a third less memory to fill and to read back than a
+/// [`Neighbor`](super::Neighbor)).
+pub(super) type Pair<E> = (InputId, E, f64);
+
 /// Where a point's neighbour pairs go: the buffers of its faces, and its block's list.
-type PairsOut<'a, const D: usize, const N: usize, E> =
-    (&'a mut Faces<E, N>, &'a mut Vec<Neighbor<D, E>>);
+type PairsOut<'a, const N: usize, E> = (&'a mut Faces<E, N>, &'a mut Vec<Pair<E>>);
 
 /// Points of the curve per block of the pieces' pass: each block lists its points' pairs in
 /// one buffer (no allocation per point).
 const BLOCK: usize = 2048;
 
 /// A block's points (their measures and the end of their pairs), and its pairs.
-type Block<const D: usize, E> = (Vec<(Option<CellMeasures<D>>, u32)>, Vec<Neighbor<D, E>>);
+type Block<const D: usize, E> = (Vec<(Option<CellMeasures<D>>, u32)>, Vec<Pair<E>>);
 
 /// The measures by pieces of every point (indexed by point; `None` for a point measured on
 /// its whole cell) and, when asked for, each point's neighbour pairs (those where it is
@@ -39,12 +42,12 @@ pub(super) struct Pieces<const D: usize, E> {
     pub(super) measures: Vec<Option<CellMeasures<D>>>,
     /// Per point: its block, and the range of its pairs there.
     at: Vec<(u32, u32, u32)>,
-    blocks: Vec<Vec<Neighbor<D, E>>>,
+    blocks: Vec<Vec<Pair<E>>>,
 }
 
 impl<const D: usize, E> Pieces<D, E> {
-    /// The neighbour pairs of point `p` (empty unless asked for).
-    pub(super) fn pairs_of(&self, p: PointId) -> &[Neighbor<D, E>] {
+    /// The neighbour pairs of point `p` (empty unless asked for), where it is `i`.
+    pub(super) fn pairs_of(&self, p: PointId) -> &[Pair<E>] {
         match self.at.get(p.index()) {
             Some(&(b, from, to)) => &self.blocks[b as usize][from as usize..to as usize],
             None => &[],
@@ -191,7 +194,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         center: &[[f64; D]],
         star: &[(CellId, u8)],
         p: PointId,
-        pairs: Option<PairsOut<'_, D, N, S::Elem>>,
+        pairs: Option<PairsOut<'_, N, S::Elem>>,
     ) -> Option<CellMeasures<D>> {
         let e = self.engine();
         let space = self.space();
@@ -290,21 +293,16 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         let position = e.points()[p.index()];
         let here = space.lifted_position((position, space.identity()));
         let i = self.input_of_vertex(p);
-        // each unordered pair of images once, as `neighbor_pairs_by` lists them
+        // each unordered pair of images once, as `neighbor_pairs_by` lists them: every
+        // edge written, then dropped unless listed here (`i < j` is a coin toss, a branch
+        // mispredicted every other edge)
         if let (Some(faces), Some(list)) = (faces, list) {
-            list.extend(
-                faces
-                    .edges
-                    .iter()
-                    .map(|&(w, g, area)| (self.input_of_vertex(e.point_of(w)), g, area))
-                    .filter(|&(j, g, _)| listed_once(i, j, g, |g| space.inverse(g)))
-                    .map(|(j, shift, area)| Neighbor {
-                        i,
-                        j,
-                        shift,
-                        area: space.measure_to_user(area, D as i32 - 1),
-                    }),
-            );
+            for &(w, g, area) in &faces.edges {
+                let j = self.input_of_vertex(e.point_of(w));
+                list.push((j, g, space.measure_to_user(area, D as i32 - 1)));
+                let listed = listed_once(i, j, g, |g| space.inverse(g));
+                list.truncate(list.len() - usize::from(!listed));
+            }
         }
         Some(CellMeasures {
             point: i,

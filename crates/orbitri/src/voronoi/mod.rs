@@ -408,7 +408,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             all.reserve_exact(
                 pieces.number_of_pairs() + whole.iter().map(|w| w.1.len()).sum::<usize>(),
             );
-            for (k, &(_, p)) in order.iter().enumerate() {
+            for (k, &(i, p)) in order.iter().enumerate() {
                 if p == PointId::NONE {
                     continue;
                 }
@@ -418,7 +418,12 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
                     order.get(k + 16).map(|o| o.1),
                     order.get(k + 4).map(|o| o.1),
                 );
-                all.extend_from_slice(pieces.pairs_of(p));
+                all.extend(pieces.pairs_of(p).iter().map(|&(j, shift, area)| Neighbor {
+                    i,
+                    j,
+                    shift,
+                    area,
+                }));
                 // (`whole` is in point order, as the filter above found them)
                 if let Ok(k) = whole.binary_search_by_key(&p, |w| w.0) {
                     all.extend_from_slice(&whole[k].1);
