@@ -439,6 +439,13 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         crate::tds::prefetch(&self.tds.cells[c.index()]);
     }
 
+    /// Starts loading the points of cell `c`'s vertices.
+    pub(crate) fn prefetch_points(&self, c: CellId) {
+        for v in self.vertices(c) {
+            crate::tds::prefetch(&self.points[self.point_index(v)]);
+        }
+    }
+
     /// A stored cell (a copy).
     #[inline(always)]
     pub fn cell(&self, c: CellId) -> Cell<S::Elem, N> {
