@@ -470,9 +470,10 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.tds.off_at(c, i)
     }
 
-    /// The point of a vertex.
+    /// The point of a vertex: the vertex's own id once 1-sheeted (no load).
+    #[inline]
     pub fn point_of(&self, v: VertexId) -> PointId {
-        self.vpoint[v.index()]
+        PointId(self.point_index(v) as u32)
     }
 
     /// The lifted vertex `i` of cell `c`.
