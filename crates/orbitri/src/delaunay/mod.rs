@@ -473,6 +473,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// The point of a vertex: the vertex's own id once 1-sheeted (no load).
     #[inline]
     pub fn point_of(&self, v: VertexId) -> PointId {
+        debug_assert!(!self.one_sheeted || self.vpoint.get(v.index()) == Some(&PointId(v.0)));
         PointId(self.point_index(v) as u32)
     }
 
