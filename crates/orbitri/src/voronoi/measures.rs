@@ -179,9 +179,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         if k + 1 < n {
             for &t in star_of(k + 1) {
                 prefetch(&center[t.index()]);
-                for v in e.vertices(t) {
-                    prefetch(&e.points()[e.point_of(v).index()]);
-                }
+                e.prefetch_points(t);
             }
         }
     }
