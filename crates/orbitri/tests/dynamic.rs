@@ -7,7 +7,8 @@ use std::collections::BTreeSet;
 
 use orbitri::sort::SplitMix;
 use orbitri::{
-    Copies, Error, FlatManifold, FlatSpace, FlatTorus, InputId, PointId, Removal, Triangulation,
+    BuildOptions, Copies, Error, FlatManifold, FlatSpace, FlatTorus, InputId, PointId, Removal,
+    Triangulation,
 };
 use proptest::prelude::*;
 
@@ -80,6 +81,73 @@ fn tori2() -> Vec<(&'static str, FlatTorus<2>)> {
             FlatTorus::triclinic([[1.0, 0.0], [0.35, 0.8]]).unwrap(),
         ),
     ]
+}
+
+/// `n` points on four parallel lines (2D) or planes (3D) across the last axis, a quarter
+/// of its length `len` apart, then `lone` points halfway between the first two: every
+/// dummy point (halfway between two planes too) and every lone point has a star of
+/// hundreds of cells.
+fn on_planes<const D: usize>(n: usize, lone: usize, len: f64, seed: u64) -> Vec<[f64; D]> {
+    let mut r = SplitMix::new(seed);
+    (0..n + lone)
+        .map(|i| {
+            let z = if i >= n { 0.125 } else { (i % 4) as f64 * 0.25 } * len;
+            std::array::from_fn(|c| if c + 1 < D { r.unit() } else { z })
+        })
+        .collect()
+}
+
+/// The large holes of points on planes (the dummy points' when they leave, the lone
+/// points' when removed), filled by gift wrapping through its index of the candidates
+/// (each apex found so is checked against trying every candidate in debug builds): the
+/// build equals one through the covering, which removes no dummy point, and removing the
+/// lone points gives a fresh build of the others. Weighted points too (on the tori), and a
+/// manifold.
+#[test]
+fn large_holes_on_planes_equal_builds_without_them() {
+    fn check<const D: usize, const N: usize, S: FlatSpace<D, N>>(
+        space: S,
+        len: f64,
+        name: &str,
+        weighted: bool,
+    ) {
+        let cover = BuildOptions {
+            dummy_threshold: usize::MAX,
+            ..Default::default()
+        };
+        let go = |_| std::ops::ControlFlow::Continue(());
+        let (n, lone) = (4000, 3);
+        let pts = on_planes::<D>(n, lone, len, 5);
+        let mut tri = Triangulation::<D, N, S>::build(space.clone(), &pts).unwrap();
+        let other = Triangulation::<D, N, S>::build_with(space.clone(), &pts, cover, go).unwrap();
+        assert!(
+            tri.used_dummy_points() && !other.used_dummy_points(),
+            "{name}"
+        );
+        assert!(geometry(&tri) == geometry(&other), "{name}");
+        for i in n..n + lone {
+            assert_eq!(
+                tri.remove(InputId::new(i)).unwrap(),
+                Removal::InPlace,
+                "{name}"
+            );
+        }
+        assert!(same_as_fresh(&tri, name), "{name}");
+        if !weighted {
+            return;
+        }
+        let w: Vec<f64> = (0..n + lone).map(|i| 1e-4 * (i % 7) as f64).collect();
+        let tri = Triangulation::<D, N, S>::build_weighted(space.clone(), &pts, &w).unwrap();
+        let other = Triangulation::<D, N, S>::build_weighted_with(space, &pts, &w, cover, go);
+        let other = other.unwrap();
+        assert!(tri.used_dummy_points(), "{name}, weighted");
+        assert!(geometry(&tri) == geometry(&other), "{name}, weighted");
+    }
+    check::<3, 4, _>(FlatTorus::cuboid([1.0; 3]).unwrap(), 1.0, "cube", true);
+    check::<2, 3, _>(FlatTorus::cuboid([1.0; 2]).unwrap(), 1.0, "square", true);
+    let dicosm = FlatManifold::platycosm("dicosm", [1.0, 1.0, 1.25]).unwrap();
+    // (weights in a manifold are equal)
+    check::<3, 4, _>(dicosm, 1.25, "dicosm", false);
 }
 
 /// Removing every other point of a large set stays in the quotient, in place, and gives

@@ -105,6 +105,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 },
                 vec![first],
                 true,
+                None,
             )
             .expect("gift wrapping closes the initial triangulation");
         self.commit(&cells);

@@ -6,6 +6,7 @@
 //! store each vertex's offset in units of the original lattice, so one insertion code path
 //! serves every level.
 
+mod ball_index;
 mod covering;
 mod flip;
 mod insert;
@@ -15,6 +16,8 @@ mod remove;
 mod ridges;
 mod validate;
 mod wrap;
+
+use rustc_hash::FxHashSet;
 
 use crate::ids::{CellId, PointId, VertexId};
 use crate::predicates::Sign;
@@ -33,6 +36,9 @@ pub type LiftedOf<S, const N: usize> =
 pub type LiftedCell<S, const N: usize> = [LiftedOf<S, N>; N];
 /// A vertex id with a lifted position.
 pub type Candidate<S, const N: usize> = (VertexId, LiftedOf<S, N>);
+
+/// The cells of a star kept in a list while fewer (see [`Engine::star`]).
+const STAR_SCANNED: usize = 256;
 
 /// Reusable buffers of one insertion or removal (no allocation per point).
 #[derive(Debug)]
@@ -532,17 +538,26 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             .index_of(v)
             .expect("vcell holds its vertex");
         let mut star = vec![(c0, i0, self.space.identity())];
-        // the cells met so far, apart: a scan of bare ids is several times cheaper
+        // the cells met so far, apart: a scan of bare ids is several times cheaper than a
+        // set, until the star is large
         let mut seen = vec![c0];
+        let mut many = FxHashSet::default();
         let mut next = 0;
         while next < star.len() {
             let (c, i, shift) = star[next];
             for k in (0..N).filter(|&k| k != i) {
                 let d = self.tds.cells[c.index()].n[k];
-                if seen.contains(&d) {
+                if seen.len() < STAR_SCANNED {
+                    if seen.contains(&d) {
+                        continue;
+                    }
+                    seen.push(d);
+                    if seen.len() == STAR_SCANNED {
+                        many.extend(seen.iter().copied());
+                    }
+                } else if !many.insert(d) {
                     continue;
                 }
-                seen.push(d);
                 let t = self.space.compose(shift, self.translation(c, k, d));
                 let j = self.tds.cells[d.index()]
                     .index_of(v)

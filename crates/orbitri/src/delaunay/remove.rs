@@ -262,10 +262,8 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         for &(c, i, shift) in &star {
             let mut arr = shifted(self, c, shift);
             let cell = self.tds.cells[c.index()];
-            for k in 0..N {
-                if k != i && !hole.iter().any(|h| h.0 == cell.v[k]) {
-                    hole.push((cell.v[k], arr[k]));
-                }
+            for k in (0..N).filter(|&k| k != i) {
+                hole.push((cell.v[k], arr[k]));
             }
             let d = cell.n[i];
             let j = self.mirror_of(d, c);
@@ -279,8 +277,21 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             }
             seeds.push((v, arr, i, true, Owner::Old(d, j)));
         }
+        // each vertex once, as the first cell that holds it lifts it
+        let mut keep: Vec<u32> = (0..hole.len() as u32).collect();
+        keep.sort_unstable_by_key(|&k| (hole[k as usize].0, k));
+        keep.dedup_by_key(|k| hole[*k as usize].0);
+        keep.sort_unstable();
+        let hole: Vec<Candidate<S, N>> = keep.iter().map(|&k| hole[k as usize]).collect();
+        let near = self.near(&hole);
         let cells = self
-            .wrap(seeds, |_, _, _| Cow::Borrowed(&hole[..]), Vec::new(), false)
+            .wrap(
+                seeds,
+                |_, _, _| Cow::Borrowed(&hole[..]),
+                Vec::new(),
+                false,
+                near.as_ref(),
+            )
             .ok_or(RemoveError::NotSimplicial)?;
         let limit = self.space.criterion_radius2(self.level);
         let breaks =

@@ -7,13 +7,37 @@ use std::borrow::Cow;
 
 use rustc_hash::FxHashMap;
 
+use super::ball_index::BallIndex;
 use super::{Candidate, Engine, LiftedCell};
 use crate::ids::{CellId, VertexId};
 use crate::predicates::Sign;
 use crate::space::{Lifted, OrbitSpace};
+use crate::voronoi::{cross, dot};
+
+/// A facet's best apex so far: vertex id, the cell it makes (positively oriented) and its
+/// vertex ids.
+type Apex<S, const N: usize> = (VertexId, LiftedCell<S, N>, [VertexId; N]);
+
+/// The fewest candidates that [`Engine::near`] indexes: below, trying them all is cheaper.
+const NEAR_FEWEST: usize = 64;
+
+/// The candidates of a large hole indexed by position (in their order), and their largest
+/// weight.
+pub(super) struct Near {
+    index: BallIndex,
+    wmax: f64,
+}
 
 /// A facet to close: vertex ids, lifted simplex, slot of the apex, side, owner.
 pub(super) type Seed<S, const N: usize> = ([VertexId; N], LiftedCell<S, N>, usize, bool, Owner);
+
+fn sub(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
+    std::array::from_fn(|c| a[c] - b[c])
+}
+
+fn norm(a: &[f64; 3]) -> f64 {
+    dot(a, a).sqrt()
+}
 
 /// Who is on the other side of an open facet.
 #[derive(Clone, Copy, Debug)]
@@ -50,43 +74,230 @@ pub(super) fn facet_key<const N: usize>(vids: &[VertexId; N], skip: usize) -> [V
 }
 
 impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
-    /// The Delaunay apex for an open facet among `cands` (vertex id, lifted point).
+    /// The candidates indexed by position, when there are many and the space places them.
+    pub(super) fn near(&self, cands: &[Candidate<S, N>]) -> Option<Near> {
+        if cands.len() < NEAR_FEWEST {
+            return None;
+        }
+        let pos = cands
+            .iter()
+            .map(|c| {
+                self.space
+                    .ball_position(c.1)
+                    .filter(|x| x.iter().all(|v| v.is_finite()))
+            })
+            .collect::<Option<Vec<_>>>()?;
+        let wmax = cands
+            .iter()
+            .map(|c| self.vertex_weight(c.0))
+            .fold(f64::NEG_INFINITY, f64::max);
+        Some(Near {
+            index: BallIndex::new(pos),
+            wmax,
+        })
+    }
+
+    /// The Delaunay apex for an open facet among `cands` (vertex id, lifted point), the
+    /// candidates near its sphere only when `near` indexes them (see [`Near`]).
     fn pivot(
         &self,
         f: &Open<S::Point, S::Elem, N>,
         cands: &[Candidate<S, N>],
+        near: Option<&Near>,
     ) -> Option<(VertexId, LiftedCell<S, N>)> {
+        if let Some(apex) = near.and_then(|near| self.pivot_near(f, cands, near)) {
+            debug_assert!(
+                apex == self.pivot(f, cands, None),
+                "the index misses the apex"
+            );
+            return apex;
+        }
+        let mut best = None;
+        for (vid, y) in cands {
+            self.contest(f, (*vid, *y), &mut best);
+        }
+        best.map(|(vid, s, _)| (vid, s))
+    }
+
+    /// The candidate `c` against the facet's best apex so far: it takes its place when it
+    /// lies on the facet's side and in the best's sphere (or there is none yet). Returns
+    /// whether it lies on that side.
+    fn contest(
+        &self,
+        f: &Open<S::Point, S::Elem, N>,
+        (vid, y): Candidate<S, N>,
+        best: &mut Option<Apex<S, N>>,
+    ) -> bool {
+        if f.vids
+            .iter()
+            .enumerate()
+            .any(|(k, &v)| k != f.idx && v == vid)
+        {
+            return false;
+        }
+        let mut s = f.arr;
+        s[f.idx] = y;
         let want = if f.toward {
             Sign::Positive
         } else {
             Sign::Negative
         };
-        let mut best: Option<(VertexId, LiftedCell<S, N>, [VertexId; N])> = None;
-        for &(vid, y) in cands {
-            if f.vids
-                .iter()
-                .enumerate()
-                .any(|(k, &v)| k != f.idx && v == vid)
-            {
-                continue;
-            }
-            let mut s = f.arr;
-            s[f.idx] = y;
-            if self.space.orient(&s) != want {
-                continue;
-            }
-            let mut vids = f.vids;
-            vids[f.idx] = vid;
-            if !f.toward {
-                s.swap((f.idx + 1) % N, (f.idx + 2) % N);
-                vids.swap((f.idx + 1) % N, (f.idx + 2) % N);
-            }
-            match &best {
-                Some((_, b, bv)) if !self.in_conflict(b, bv, y, self.vertex_weight(vid)) => {}
-                _ => best = Some((vid, s, vids)),
-            }
+        if self.space.orient(&s) != want {
+            return false;
         }
-        best.map(|(vid, s, _)| (vid, s))
+        let mut vids = f.vids;
+        vids[f.idx] = vid;
+        if !f.toward {
+            s.swap((f.idx + 1) % N, (f.idx + 2) % N);
+            vids.swap((f.idx + 1) % N, (f.idx + 2) % N);
+        }
+        match best {
+            Some((_, b, bv)) if !self.in_conflict(b, bv, y, self.vertex_weight(vid)) => {}
+            _ => *best = Some((vid, s, vids)),
+        }
+        true
+    }
+
+    /// [`Self::pivot`] through the index. First a candidate on the facet's side: the
+    /// spheres through the facet's circle are ordered by the height of their center over
+    /// it, the apex's the lowest, and a best-first search of the index meets the candidates
+    /// clearly off the facet's plane in that order, at rounded positions, until one is on
+    /// the side (points on the plane, whose orientation takes the exact arithmetic, are
+    /// not tried). Then only the candidates in the ball of its sphere: every candidate
+    /// that beats it lies in that sphere. `None` when rounded positions cannot be trusted
+    /// here (no position, a flat facet or first cell, no candidate found clearly off the
+    /// plane): the caller then tries them all.
+    fn pivot_near(
+        &self,
+        f: &Open<S::Point, S::Elem, N>,
+        cands: &[Candidate<S, N>],
+        near: &Near,
+    ) -> Option<Option<(VertexId, LiftedCell<S, N>)>> {
+        let mut at = [[0.0; 3]; N];
+        for (k, p) in at.iter_mut().enumerate() {
+            *p = self.space.ball_position(f.arr[k])?;
+        }
+        let rest: Vec<[f64; 3]> = (0..N).filter(|&k| k != f.idx).map(|k| at[k]).collect();
+        // the facet's normal and its circle (center `o`, squared radius `rr`)
+        let e: [[f64; 3]; 2] = std::array::from_fn(|i| {
+            std::array::from_fn(|c| rest[(i + 1).min(N - 2)][c] - rest[0][c])
+        });
+        let (n, o) = if N == 4 {
+            let n = cross(&e[0], &e[1]);
+            let w: [f64; 3] =
+                std::array::from_fn(|c| dot(&e[0], &e[0]) * e[1][c] - dot(&e[1], &e[1]) * e[0][c]);
+            let m = cross(&w, &n);
+            let k = 2.0 * dot(&n, &n);
+            (n, std::array::from_fn(|c| rest[0][c] + m[c] / k))
+        } else {
+            let n = [-e[0][1], e[0][0], 0.0];
+            (n, std::array::from_fn(|c| rest[0][c] + e[0][c] / 2.0))
+        };
+        let rr = dot(&sub(&rest[0], &o), &sub(&rest[0], &o));
+        // toward the side of the point the apex replaces when `toward`, away otherwise
+        let to_replaced = sub(&at[f.idx], &o);
+        let h = dot(&n, &to_replaced);
+        // (NaN fails too)
+        let clear = h.abs() > 1e-9 * norm(&n) * norm(&to_replaced);
+        if !clear || !rr.is_finite() {
+            return None;
+        }
+        let unit = (if (h > 0.0) == f.toward { 1.0 } else { -1.0 }) / norm(&n);
+        let n = n.map(|x| x * unit);
+        // the spheres through the facet's circle, by the height of their center over it:
+        // that of a candidate clearly on the side, and a lower bound over a box
+        let height = |y: &[f64; 3]| {
+            let v = sub(y, &o);
+            let h = dot(&n, &v);
+            (h > 1e-9 * norm(&v)).then(|| (dot(&v, &v) - rr) / (2.0 * h))
+        };
+        let bound = |lo: &[f64; 3], hi: &[f64; 3]| {
+            let (mut d2, mut low, mut high) = (0.0, 0.0, 0.0);
+            for c in 0..3 {
+                let e = (lo[c] - o[c]).max(o[c] - hi[c]).max(0.0);
+                d2 += e * e;
+                let (a, b) = (n[c] * (lo[c] - o[c]), n[c] * (hi[c] - o[c]));
+                low += a.min(b);
+                high += a.max(b);
+            }
+            if high <= 0.0 {
+                f64::INFINITY
+            } else if d2 >= rr {
+                (d2 - rr) / (2.0 * high)
+            } else if low > 0.0 {
+                (d2 - rr) / (2.0 * low)
+            } else {
+                f64::NEG_INFINITY
+            }
+        };
+        let mut best = None;
+        let first = near.index.first_by(bound, height, |j| {
+            self.contest(f, cands[j as usize], &mut best)
+        })?;
+        let (vid, s, vids) = best?;
+        let ball = self.ball(&s, &vids, near.wmax, near.index.scale)?;
+        let mut list = Vec::new();
+        near.index.within(ball.0, ball.1, &mut list);
+        best = Some((vid, s, vids));
+        for &j in list.iter().filter(|&&j| j != first) {
+            self.contest(f, cands[j as usize], &mut best);
+        }
+        Some(best.map(|(vid, s, _)| (vid, s)))
+    }
+
+    /// A ball (center, radius) that holds every candidate in conflict with the cell `s`
+    /// (vertex ids `vids`), of weight at most `wmax`, at its rounded position; `None` when
+    /// the cell is too flat for rounded positions to place its sphere.
+    fn ball(
+        &self,
+        s: &LiftedCell<S, N>,
+        vids: &[VertexId; N],
+        wmax: f64,
+        scale: f64,
+    ) -> Option<([f64; 3], f64)> {
+        let x0 = self.space.ball_position(s[0])?;
+        let w0 = self.vertex_weight(vids[0]);
+        let mut d = [[0.0; 3]; 3];
+        let mut rhs = [0.0; 3];
+        for i in 1..N {
+            let x = self.space.ball_position(s[i])?;
+            d[i - 1] = std::array::from_fn(|c| x[c] - x0[c]);
+            rhs[i - 1] = (dot(&d[i - 1], &d[i - 1]) - (self.vertex_weight(vids[i]) - w0)) / 2.0;
+        }
+        // the orthocenter `x0 + z`, with `d_i·z = rhs_i` (Cramer's rule)
+        let (z, det) = if N == 4 {
+            let (c12, c20, c01) = (
+                cross(&d[1], &d[2]),
+                cross(&d[2], &d[0]),
+                cross(&d[0], &d[1]),
+            );
+            let det = dot(&d[0], &c12);
+            let z = std::array::from_fn(|c| {
+                (rhs[0] * c12[c] + rhs[1] * c20[c] + rhs[2] * c01[c]) / det
+            });
+            (z, det)
+        } else {
+            let det = d[0][0] * d[1][1] - d[0][1] * d[1][0];
+            let z = [
+                (rhs[0] * d[1][1] - rhs[1] * d[0][1]) / det,
+                (d[0][0] * rhs[1] - d[1][0] * rhs[0]) / det,
+                0.0,
+            ];
+            (z, det)
+        };
+        let size: f64 = (0..N - 1).map(|i| dot(&d[i], &d[i]).sqrt()).product();
+        // (far from flat, the rounding of the positions moves the center by a small
+        // multiple of their own)
+        let placed = det.abs() >= 1e-4 * size;
+        if !placed || !z.iter().all(|x| x.is_finite()) {
+            return None;
+        }
+        let r2 = dot(&z, &z) - w0 + wmax;
+        let len2 = (0..N - 1).map(|i| dot(&d[i], &d[i])).fold(0.0, f64::max);
+        let slack = 1e-6 * (dot(&z, &z) + w0.abs() + wmax.abs() + len2);
+        let r = (r2.max(0.0) * (1.0 + 1e-6) + slack).sqrt() + 1e-5 * scale;
+        r.is_finite()
+            .then(|| (std::array::from_fn(|c| x0[c] + z[c]), r))
     }
 
     /// Closes every facet of `open` (and every facet the new cells leave open); the apex of
@@ -106,6 +317,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         ) -> Cow<'c, [Candidate<S, N>]>,
         mut first: Vec<Wrapped<S::Point, S::Elem, N>>,
         recenter: bool,
+        near: Option<&Near>,
     ) -> Option<Vec<Wrapped<S::Point, S::Elem, N>>>
     where
         S::Point: 'c,
@@ -131,7 +343,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         while let Some(key) = queue.pop() {
             let Some(f) = open.remove(&key) else { continue };
             let cands = candidates(&f.vids, &f.arr, f.idx);
-            let (vid, mut arr) = self.pivot(&f, &cands)?;
+            let (vid, mut arr) = self.pivot(&f, &cands, near)?;
             let mut vids = f.vids;
             vids[f.idx] = vid;
             if !f.toward {

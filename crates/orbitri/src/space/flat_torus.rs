@@ -712,6 +712,10 @@ macro_rules! flat_torus_plugin {
         fn dummy_points(&self) -> Vec<Self::Point> {
             self.lattice.dummy_grid()
         }
+
+        fn ball_position(&self, p: (Self::Point, Self::Elem)) -> Option<[f64; 3]> {
+            Some(super::padded(self.position(p)))
+        }
     };
 }
 pub(super) use flat_torus_plugin;

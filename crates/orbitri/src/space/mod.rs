@@ -192,6 +192,13 @@ pub trait OrbitSpace<const N: usize>: Sync + Send {
     /// An upper bound on the length of a Delaunay edge: at level 0 for any non-empty point
     /// set, at a later level under that level's criterion.
     fn edge_bound(&self, level: usize) -> f64;
+    /// The Cartesian position of a lifted point (rounded; a 2D point with a zero third
+    /// coordinate), in spaces whose in-sphere and power tests are those of Euclidean balls
+    /// at these positions: what lets a large hole's apex search look only near a sphere.
+    /// `None` (the default) elsewhere.
+    fn ball_position(&self, _: Lifted<Self::Point, Self::Elem>) -> Option<[f64; 3]> {
+        None
+    }
     /// A key along a space-filling curve, for spatial sorting: the index along a Hilbert
     /// curve of `KEY_BITS` bits, whose leading `D·b` bits index the grid of `2^b` cells per
     /// axis over the domain (the jump-and-walk grid).
@@ -278,6 +285,11 @@ pub trait FlatSpace<const D: usize, const N: usize>:
     /// Ok when the space's volume is a normal double in user units (see
     /// [`Lattice::check_volume_representable`]).
     fn check_volume_representable(&self) -> crate::error::Result<()>;
+}
+
+/// A point of the plane or of space as three coordinates (the third zero in the plane).
+pub(crate) fn padded<const D: usize>(x: [f64; D]) -> [f64; 3] {
+    std::array::from_fn(|c| if c < D { x[c] } else { 0.0 })
 }
 
 /// The canonical frame of a few (tag, element) pairs (at most 4: a cell or one of its faces):

@@ -99,7 +99,7 @@ pub struct Neighbor<const D: usize, E = [i8; D]> {
     pub area: f64,
 }
 
-fn cross(a: &[f64], b: &[f64]) -> [f64; 3] {
+pub(crate) fn cross(a: &[f64], b: &[f64]) -> [f64; 3] {
     [
         a[1] * b[2] - a[2] * b[1],
         a[2] * b[0] - a[0] * b[2],
@@ -107,7 +107,7 @@ fn cross(a: &[f64], b: &[f64]) -> [f64; 3] {
     ]
 }
 
-fn dot(a: &[f64], b: &[f64]) -> f64 {
+pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
