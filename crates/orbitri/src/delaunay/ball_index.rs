@@ -110,7 +110,8 @@ impl BallIndex {
 
     /// The candidates in increasing order of `key` (those it gives one), until `accept`
     /// takes one, which is returned: a best-first search, `bound(lo, hi)` a lower bound of
-    /// the key over a box (infinite when no point of the box has a key).
+    /// the key over a box (infinite when no point of the box has a key). With a bound that
+    /// is only a guess somewhere, the order is only about that.
     pub fn first_by(
         &self,
         bound: impl Fn(&[f64; 3], &[f64; 3]) -> f64,

@@ -158,13 +158,14 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         true
     }
 
-    /// [`Self::pivot`] through the index. First a candidate on the facet's side: the
-    /// spheres through the facet's circle are ordered by the height of their center over
-    /// it, the apex's the lowest, and a best-first search of the index meets the candidates
-    /// clearly off the facet's plane in that order, at rounded positions, until one is on
-    /// the side (points on the plane, whose orientation takes the exact arithmetic, are
-    /// not tried). Then only the candidates in the ball of its sphere: every candidate
-    /// that beats it lies in that sphere. `None` when rounded positions cannot be trusted
+    /// [`Self::pivot`] through the index. First a candidate on the facet's side, likely
+    /// the apex or near it: the spheres through the facet's circle are ordered by the
+    /// height of their center over it, the apex's the lowest, and a best-first search of
+    /// the index meets the candidates clearly off the facet's plane about in that order,
+    /// at rounded positions, until one is on the side (points on the plane, whose
+    /// orientation takes the exact arithmetic, are not tried). Then only the candidates in
+    /// the ball of its sphere: every candidate that beats it lies in that sphere, so the
+    /// answer does not depend on the first step's guesses. `None` when rounded positions cannot be trusted
     /// here (no position, a flat facet or first cell, no candidate found clearly off the
     /// plane): the caller then tries them all.
     fn pivot_near(
@@ -205,29 +206,24 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         let unit = (if (h > 0.0) == f.toward { 1.0 } else { -1.0 }) / norm(&n);
         let n = n.map(|x| x * unit);
         // the spheres through the facet's circle, by the height of their center over it:
-        // that of a candidate clearly on the side, and a lower bound over a box
+        // that of a candidate clearly on the side, and a box's priority (a lower bound
+        // outside the facet's ball, a guess inside it)
         let height = |y: &[f64; 3]| {
             let v = sub(y, &o);
             let h = dot(&n, &v);
             (h > 1e-9 * norm(&v)).then(|| (dot(&v, &v) - rr) / (2.0 * h))
         };
         let bound = |lo: &[f64; 3], hi: &[f64; 3]| {
-            let (mut d2, mut low, mut high) = (0.0, 0.0, 0.0);
+            let (mut d2, mut high) = (0.0, 0.0);
             for c in 0..3 {
                 let e = (lo[c] - o[c]).max(o[c] - hi[c]).max(0.0);
                 d2 += e * e;
-                let (a, b) = (n[c] * (lo[c] - o[c]), n[c] * (hi[c] - o[c]));
-                low += a.min(b);
-                high += a.max(b);
+                high += (n[c] * (lo[c] - o[c])).max(n[c] * (hi[c] - o[c]));
             }
             if high <= 0.0 {
                 f64::INFINITY
-            } else if d2 >= rr {
-                (d2 - rr) / (2.0 * high)
-            } else if low > 0.0 {
-                (d2 - rr) / (2.0 * low)
             } else {
-                f64::NEG_INFINITY
+                (d2 - rr) / (2.0 * high)
             }
         };
         let mut best = None;
