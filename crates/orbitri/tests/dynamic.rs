@@ -102,7 +102,7 @@ fn on_planes<const D: usize>(n: usize, lone: usize, len: f64, seed: u64) -> Vec<
 /// (each apex found so is checked against trying every candidate in debug builds): the
 /// build equals one through the covering, which removes no dummy point, and removing the
 /// lone points gives a fresh build of the others. Weighted points too (on the tori), and a
-/// manifold.
+/// manifold (whose holes are wrapped without the index).
 #[test]
 fn large_holes_on_planes_equal_builds_without_them() {
     fn check<const D: usize, const N: usize, S: FlatSpace<D, N>>(

@@ -27,19 +27,15 @@ pub(super) struct BallIndex {
     pos: Vec<[f64; 3]>,
     order: Vec<u32>,
     nodes: Vec<Node>,
-    /// The largest absolute coordinate (the rounding of the positions is relative to it).
-    pub scale: f64,
 }
 
 impl BallIndex {
     /// The tree of `pos` (finite coordinates).
     pub fn new(pos: Vec<[f64; 3]>) -> Self {
-        let scale = pos.iter().flatten().fold(0.0f64, |m, &x| m.max(x.abs()));
         let mut t = BallIndex {
             order: (0..pos.len() as u32).collect(),
             pos,
             nodes: Vec::new(),
-            scale,
         };
         t.split(0, t.pos.len());
         t
@@ -77,6 +73,11 @@ impl BallIndex {
             self.nodes[at].children = [left, right];
         }
         at as u32
+    }
+
+    /// The number of candidates.
+    pub fn len(&self) -> usize {
+        self.pos.len()
     }
 
     /// The candidates within distance `r` of `c` (and maybe a few more), appended to `out`.

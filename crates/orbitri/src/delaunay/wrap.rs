@@ -21,10 +21,11 @@ type Apex<S, const N: usize> = (VertexId, LiftedCell<S, N>, [VertexId; N]);
 /// The fewest candidates that [`Engine::near`] indexes: below, trying them all is cheaper.
 const NEAR_FEWEST: usize = 64;
 
-/// The candidates of a large hole indexed by position (in their order), and their largest
-/// weight.
+/// The candidates of a large hole indexed by position (in their order), a bound on the
+/// rounding of every position, and their largest weight.
 pub(super) struct Near {
     index: BallIndex,
+    eps: f64,
     wmax: f64,
 }
 
@@ -79,20 +80,22 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         if cands.len() < NEAR_FEWEST {
             return None;
         }
+        let mut eps = 0.0f64;
         let pos = cands
             .iter()
             .map(|c| {
-                self.space
-                    .ball_position(c.1)
-                    .filter(|x| x.iter().all(|v| v.is_finite()))
+                let (x, e) = self.space.ball_position(c.1)?;
+                eps = eps.max(e);
+                x.iter().all(|v| v.is_finite()).then_some(x)
             })
             .collect::<Option<Vec<_>>>()?;
         let wmax = cands
             .iter()
             .map(|c| self.vertex_weight(c.0))
             .fold(f64::NEG_INFINITY, f64::max);
-        Some(Near {
+        (eps.is_finite() && wmax.is_finite()).then(|| Near {
             index: BallIndex::new(pos),
+            eps,
             wmax,
         })
     }
@@ -174,9 +177,14 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         cands: &[Candidate<S, N>],
         near: &Near,
     ) -> Option<Option<(VertexId, LiftedCell<S, N>)>> {
+        debug_assert_eq!(
+            near.index.len(),
+            cands.len(),
+            "the index is of these candidates"
+        );
         let mut at = [[0.0; 3]; N];
         for (k, p) in at.iter_mut().enumerate() {
-            *p = self.space.ball_position(f.arr[k])?;
+            *p = self.space.ball_position(f.arr[k])?.0;
         }
         let rest: Vec<[f64; 3]> = (0..N).filter(|&k| k != f.idx).map(|k| at[k]).collect();
         // the facet's normal and its circle (center `o`, squared radius `rr`)
@@ -231,7 +239,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             self.contest(f, cands[j as usize], &mut best)
         })?;
         let (vid, s, vids) = best?;
-        let ball = self.ball(&s, &vids, near.wmax, near.index.scale)?;
+        let ball = self.ball(&s, &vids, near)?;
         let mut list = Vec::new();
         near.index.within(ball.0, ball.1, &mut list);
         best = Some((vid, s, vids));
@@ -241,27 +249,40 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         Some(best.map(|(vid, s, _)| (vid, s)))
     }
 
-    /// A ball (center, radius) that holds every candidate in conflict with the cell `s`
-    /// (vertex ids `vids`), of weight at most `wmax`, at its rounded position; `None` when
-    /// the cell is too flat for rounded positions to place its sphere.
+    /// A ball (center, radius) that holds the rounded position of every candidate of
+    /// `near` in conflict with the cell `s` (vertex ids `vids`), whatever the rounding of
+    /// the positions; `None` when the rounding could make the cell flat.
+    ///
+    /// The center `c` is solved from the rounded positions. With the exact ones `x̃_i`,
+    /// `g_i(c) = |x̃_i − c|² − w_i − |x̃_0 − c|² + w_0` is `−2(x̃_i − x̃_0)·(c − c*)` for
+    /// the exact orthocenter `c*`, so `|c − c*| ≤ ‖D̃⁻¹‖·|g|/2`, where `D̃`'s rows are the
+    /// exact edge vectors; `g` is evaluated at the rounded positions with the rounding's
+    /// effect added, and `‖D̃⁻¹‖ ≤ 2·‖adj D‖/|det D|` for the rounded `D` while the
+    /// difference of the two, `η`, keeps `η·‖adj D‖/|det D| ≤ 1/2`.
     fn ball(
         &self,
         s: &LiftedCell<S, N>,
         vids: &[VertexId; N],
-        wmax: f64,
-        scale: f64,
+        near: &Near,
     ) -> Option<([f64; 3], f64)> {
-        let x0 = self.space.ball_position(s[0])?;
-        let w0 = self.vertex_weight(vids[0]);
+        const U: f64 = f64::EPSILON;
+        let mut x = [[0.0; 3]; N];
+        let mut eps = near.eps;
+        for (xi, si) in x.iter_mut().zip(s) {
+            let (p, e) = self.space.ball_position(*si)?;
+            (*xi, eps) = (p, eps.max(e));
+        }
+        let w: [f64; N] = std::array::from_fn(|i| self.vertex_weight(vids[i]));
         let mut d = [[0.0; 3]; 3];
         let mut rhs = [0.0; 3];
         for i in 1..N {
-            let x = self.space.ball_position(s[i])?;
-            d[i - 1] = std::array::from_fn(|c| x[c] - x0[c]);
-            rhs[i - 1] = (dot(&d[i - 1], &d[i - 1]) - (self.vertex_weight(vids[i]) - w0)) / 2.0;
+            d[i - 1] = sub(&x[i], &x[0]);
+            rhs[i - 1] = (dot(&d[i - 1], &d[i - 1]) - (w[i] - w[0])) / 2.0;
         }
-        // the orthocenter `x0 + z`, with `d_i·z = rhs_i` (Cramer's rule)
-        let (z, det) = if N == 4 {
+        let len: [f64; 3] = std::array::from_fn(|i| norm(&d[i]));
+        // the center `x_0 + z`, `d_i·z = rhs_i` by Cramer's rule; the adjugate's norm and
+        // the determinant's rounding error (a multiple of the product of the rows' norms)
+        let (z, det, adj, det_err) = if N == 4 {
             let (c12, c20, c01) = (
                 cross(&d[1], &d[2]),
                 cross(&d[2], &d[0]),
@@ -271,7 +292,9 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             let z = std::array::from_fn(|c| {
                 (rhs[0] * c12[c] + rhs[1] * c20[c] + rhs[2] * c01[c]) / det
             });
-            (z, det)
+            let adj = (dot(&c12, &c12) + dot(&c20, &c20) + dot(&c01, &c01)).sqrt()
+                + 8.0 * U * (len[1] * len[2] + len[2] * len[0] + len[0] * len[1]);
+            (z, det, adj, 16.0 * U * len[0] * len[1] * len[2])
         } else {
             let det = d[0][0] * d[1][1] - d[0][1] * d[1][0];
             let z = [
@@ -279,21 +302,35 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 (d[0][0] * rhs[1] - d[1][0] * rhs[0]) / det,
                 0.0,
             ];
-            (z, det)
+            let adj = (len[0] * len[0] + len[1] * len[1]).sqrt() * (1.0 + 4.0 * U);
+            (z, det, adj, 8.0 * U * len[0] * len[1])
         };
-        let size: f64 = (0..N - 1).map(|i| dot(&d[i], &d[i]).sqrt()).product();
-        // (far from flat, the rounding of the positions moves the center by a small
-        // multiple of their own)
-        let placed = det.abs() >= 1e-4 * size;
-        if !placed || !z.iter().all(|x| x.is_finite()) {
+        let certain = det.abs() > 2.0 * det_err;
+        let inverse = adj / (det.abs() - det_err);
+        // the rounded edge vectors against the exact ones (Frobenius norm); (NaN fails)
+        let eta: f64 = (0..N - 1).map(|i| U * len[i] + 2.0 * eps).sum();
+        let close = inverse * eta <= 0.5;
+        if !certain || !close {
             return None;
         }
-        let r2 = dot(&z, &z) - w0 + wmax;
-        let len2 = (0..N - 1).map(|i| dot(&d[i], &d[i])).fold(0.0, f64::max);
-        let slack = 1e-6 * (dot(&z, &z) + w0.abs() + wmax.abs() + len2);
-        let r = (r2.max(0.0) * (1.0 + 1e-6) + slack).sqrt() + 1e-5 * scale;
-        r.is_finite()
-            .then(|| (std::array::from_fn(|c| x0[c] + z[c]), r))
+        let c: [f64; 3] = std::array::from_fn(|k| x[0][k] + z[k]);
+        let rho: [f64; N] = std::array::from_fn(|i| norm(&sub(&x[i], &c)));
+        let g2: f64 = (1..N)
+            .map(|i| {
+                let r = rho[i] * rho[i] - rho[0] * rho[0] - (w[i] - w[0]);
+                let bound = r.abs()
+                    + 8.0 * U * (rho[i] * rho[i] + rho[0] * rho[0] + (w[i] - w[0]).abs())
+                    + 2.0 * eps * (rho[i] + rho[0] + 2.0 * eps);
+                bound * bound
+            })
+            .sum();
+        let off = 2.0 * inverse * g2.sqrt() / 2.0;
+        // a conflict at `y`: |y − c*|² − w_y < |x̃_0 − c*|² − w_0, and w_y ≤ wmax
+        let reach = rho[0] * (1.0 + 2.0 * U) + eps + off;
+        let r2 = reach * reach - w[0] + near.wmax;
+        let r2 = r2 + 8.0 * U * (reach * reach + w[0].abs() + near.wmax.abs());
+        let r = (r2.max(0.0).sqrt() + off + eps) * (1.0 + 8.0 * U);
+        (r.is_finite() && c.iter().all(|v| v.is_finite())).then_some((c, r))
     }
 
     /// Closes every facet of `open` (and every facet the new cells leave open); the apex of

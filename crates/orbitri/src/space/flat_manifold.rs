@@ -992,10 +992,6 @@ where
         self.cosets[h.coset as usize].reverses
     }
 
-    fn ball_position(&self, (p, g): (P<D>, Motion<D>)) -> Option<[f64; 3]> {
-        Some(super::padded(self.position(&p, g)))
-    }
-
     fn dummy_points(&self) -> Vec<P<D>> {
         // a grid over T's domain fine enough for δ(G), of which the slab is kept (its images
         // fill the rest); T's internal frame is the manifold's divided by `scale` (exactly)

@@ -146,6 +146,17 @@ impl<const D: usize> FlatTorus<D> {
         std::array::from_fn(|c| p[c] + s[c])
     }
 
+    /// [`Self::position`] and a bound on its distance to the exact position: each
+    /// coordinate `p + Σ t_k·m_k` takes at most `D + 1` roundings of its terms' sum.
+    pub(crate) fn position_with_error(&self, (p, o): L<D>) -> ([f64; D], f64) {
+        let (s, a) = self.lattice.rows.apply(widen(o));
+        let err: f64 = (0..D).map(|c| p[c].abs() + a[c]).sum();
+        (
+            std::array::from_fn(|c| p[c] + s[c]),
+            8.0 * f64::EPSILON * err,
+        )
+    }
+
     /// The lifted points as exact integers, all scaled by one power of two.
     pub(super) fn exact_lift(&self, pts: &[L<D>]) -> Vec<[BigInt; D]> {
         self.exact_lift_scaled(pts).0
@@ -713,8 +724,9 @@ macro_rules! flat_torus_plugin {
             self.lattice.dummy_grid()
         }
 
-        fn ball_position(&self, p: (Self::Point, Self::Elem)) -> Option<[f64; 3]> {
-            Some(super::padded(self.position(p)))
+        fn ball_position(&self, p: (Self::Point, Self::Elem)) -> Option<([f64; 3], f64)> {
+            let (x, err) = self.position_with_error(p);
+            Some((super::padded(x), err))
         }
     };
 }

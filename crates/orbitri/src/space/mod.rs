@@ -192,11 +192,12 @@ pub trait OrbitSpace<const N: usize>: Sync + Send {
     /// An upper bound on the length of a Delaunay edge: at level 0 for any non-empty point
     /// set, at a later level under that level's criterion.
     fn edge_bound(&self, level: usize) -> f64;
-    /// The Cartesian position of a lifted point (rounded; a 2D point with a zero third
-    /// coordinate), in spaces whose in-sphere and power tests are those of Euclidean balls
-    /// at these positions: what lets a large hole's apex search look only near a sphere.
-    /// `None` (the default) elsewhere.
-    fn ball_position(&self, _: Lifted<Self::Point, Self::Elem>) -> Option<[f64; 3]> {
+    /// The Cartesian position of a lifted point, rounded (a 2D point with a zero third
+    /// coordinate), and a bound on its distance to the exact one, in spaces whose in-sphere
+    /// and power tests are those of Euclidean balls at these positions and whose perturbed
+    /// tests order every pencil of spheres: what lets a large hole's apex search look only
+    /// near a sphere. `None` (the default) elsewhere.
+    fn ball_position(&self, _: Lifted<Self::Point, Self::Elem>) -> Option<([f64; 3], f64)> {
         None
     }
     /// A key along a space-filling curve, for spatial sorting: the index along a Hilbert
