@@ -18,6 +18,10 @@ use crate::voronoi::{cross, dot};
 /// vertex ids.
 type Apex<S, const N: usize> = (VertexId, LiftedCell<S, N>, [VertexId; N]);
 
+/// 2⁻²⁰⁰: a cell's edges shorter than this, or longer than its inverse, are tried against
+/// every candidate (see [`Engine::ball`]).
+const TINY: f64 = 1.0 / ((1u128 << 100) as f64 * (1u128 << 100) as f64);
+
 /// The fewest candidates that [`Engine::near`] indexes: below, trying them all is cheaper.
 const NEAR_FEWEST: usize = 64;
 
@@ -251,7 +255,8 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
 
     /// A ball (center, radius) that holds the rounded position of every candidate of
     /// `near` in conflict with the cell `s` (vertex ids `vids`), whatever the rounding of
-    /// the positions; `None` when the rounding could make the cell flat.
+    /// the positions; `None` when the rounding could make the cell flat, or its edges are
+    /// so short or long that products of them could underflow or overflow.
     ///
     /// The center `c` is solved from the rounded positions. With the exact ones `x̃_i`,
     /// `g_i(c) = |x̃_i − c|² − w_i − |x̃_0 − c|² + w_0` is `−2(x̃_i − x̃_0)·(c − c*)` for
@@ -280,6 +285,12 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             rhs[i - 1] = (dot(&d[i - 1], &d[i - 1]) - (w[i] - w[0])) / 2.0;
         }
         let len: [f64; 3] = std::array::from_fn(|i| norm(&d[i]));
+        // (edges in [2⁻²⁰⁰, 2²⁰⁰]: no product below keeps or loses a subnormal that matters
+        // against the error terms, and none overflows)
+        let tame = TINY..=1.0 / TINY;
+        if !len[..N - 1].iter().all(|l| tame.contains(l)) {
+            return None;
+        }
         // the center `x_0 + z`, `d_i·z = rhs_i` by Cramer's rule; the adjugate's norm and
         // the determinant's rounding error (a multiple of the product of the rows' norms)
         let (z, det, adj, det_err) = if N == 4 {
@@ -315,20 +326,20 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         }
         let c: [f64; 3] = std::array::from_fn(|k| x[0][k] + z[k]);
         let rho: [f64; N] = std::array::from_fn(|i| norm(&sub(&x[i], &c)));
-        let g2: f64 = (1..N)
+        // |g| ≤ Σ|g_i| (no square to underflow)
+        let g: f64 = (1..N)
             .map(|i| {
                 let r = rho[i] * rho[i] - rho[0] * rho[0] - (w[i] - w[0]);
-                let bound = r.abs()
+                r.abs()
                     + 8.0 * U * (rho[i] * rho[i] + rho[0] * rho[0] + (w[i] - w[0]).abs())
-                    + 2.0 * eps * (rho[i] + rho[0] + 2.0 * eps);
-                bound * bound
+                    + 2.0 * eps * (rho[i] + rho[0] + 2.0 * eps)
             })
             .sum();
-        let off = 2.0 * inverse * g2.sqrt() / 2.0;
+        let off = 2.0 * inverse * g / 2.0;
         // a conflict at `y`: |y − c*|² − w_y < |x̃_0 − c*|² − w_0, and w_y ≤ wmax
         let reach = rho[0] * (1.0 + 2.0 * U) + eps + off;
-        let r2 = reach * reach - w[0] + near.wmax;
-        let r2 = r2 + 8.0 * U * (reach * reach + w[0].abs() + near.wmax.abs());
+        let spread = near.wmax - w[0];
+        let r2 = reach * reach + spread + 8.0 * U * (reach * reach + spread.abs());
         let r = (r2.max(0.0).sqrt() + off + eps) * (1.0 + 8.0 * U);
         (r.is_finite() && c.iter().all(|v| v.is_finite())).then_some((c, r))
     }
