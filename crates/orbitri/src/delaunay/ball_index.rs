@@ -2,7 +2,8 @@
 //! search: the apex of a facet lies in the sphere of the facet and any candidate on its
 //! side (the pencil of spheres through the facet is ordered), so once one such candidate
 //! is known only the candidates in that sphere's ball need the exact tests. Positions are
-//! rounded; the balls asked for carry a margin, and the exact predicates decide.
+//! rounded; the balls asked for are widened by a bound on that rounding, and the exact
+//! predicates decide.
 
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;

@@ -10,17 +10,14 @@ use rustc_hash::FxHashMap;
 use super::ball_index::BallIndex;
 use super::{Candidate, Engine, LiftedCell};
 use crate::ids::{CellId, VertexId};
+use crate::predicates::filter::{HUGE, TINY};
 use crate::predicates::Sign;
 use crate::space::{Lifted, OrbitSpace};
-use crate::voronoi::{cross, dot};
+use crate::voronoi::{cross, dot, sub};
 
 /// A facet's best apex so far: vertex id, the cell it makes (positively oriented) and its
 /// vertex ids.
 type Apex<S, const N: usize> = (VertexId, LiftedCell<S, N>, [VertexId; N]);
-
-/// 2⁻²⁰⁰: a cell's edges shorter than this, or longer than its inverse, are tried against
-/// every candidate (see [`Engine::ball`]).
-const TINY: f64 = 1.0 / ((1u128 << 100) as f64 * (1u128 << 100) as f64);
 
 /// The fewest candidates that [`Engine::near`] indexes: below, trying them all is cheaper.
 const NEAR_FEWEST: usize = 64;
@@ -35,10 +32,6 @@ pub(super) struct Near {
 
 /// A facet to close: vertex ids, lifted simplex, slot of the apex, side, owner.
 pub(super) type Seed<S, const N: usize> = ([VertexId; N], LiftedCell<S, N>, usize, bool, Owner);
-
-fn sub(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
-    std::array::from_fn(|c| a[c] - b[c])
-}
 
 fn norm(a: &[f64; 3]) -> f64 {
     dot(a, a).sqrt()
@@ -172,9 +165,9 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// at rounded positions, until one is on the side (points on the plane, whose
     /// orientation takes the exact arithmetic, are not tried). Then only the candidates in
     /// the ball of its sphere: every candidate that beats it lies in that sphere, so the
-    /// answer does not depend on the first step's guesses. `None` when rounded positions cannot be trusted
-    /// here (no position, a flat facet or first cell, no candidate found clearly off the
-    /// plane): the caller then tries them all.
+    /// answer does not depend on the first step's guesses. `None` when rounded positions
+    /// cannot be trusted here (no position, a flat facet or first cell, no candidate found
+    /// clearly off the plane): the caller then tries them all.
     fn pivot_near(
         &self,
         f: &Open<S::Point, S::Elem, N>,
@@ -287,7 +280,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         let len: [f64; 3] = std::array::from_fn(|i| norm(&d[i]));
         // (edges in [2⁻²⁰⁰, 2²⁰⁰]: no product below keeps or loses a subnormal that matters
         // against the error terms, and none overflows)
-        let tame = TINY..=1.0 / TINY;
+        let tame = TINY..=HUGE;
         if !len[..N - 1].iter().all(|l| tame.contains(l)) {
             return None;
         }

@@ -6,8 +6,8 @@ use super::Sign;
 const U: f64 = f64::EPSILON * 0.5;
 /// Rows whose magnitude bound lies outside this range skip the filter (no underflow or
 /// overflow can then occur in a degree-5 product).
-const TINY: f64 = 1.0 / HUGE; // 2^-200
-const HUGE: f64 = (1u128 << 100) as f64 * (1u128 << 100) as f64; // 2^200
+pub(crate) const TINY: f64 = 1.0 / HUGE; // 2^-200
+pub(crate) const HUGE: f64 = (1u128 << 100) as f64 * (1u128 << 100) as f64; // 2^200
 
 /// A lattice given by its rows (the lattice vectors), as the predicates need it.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -12,7 +12,8 @@
 use rayon::prelude::*;
 
 use super::{
-    cross, dot, listed_once, slots_but, slots_but_two, CellMeasures, Faces, Stars, POINTS_PER_POLL,
+    cross, dot, listed_once, slots_but, slots_but_two, sub, CellMeasures, Faces, Stars,
+    POINTS_PER_POLL,
 };
 use crate::error::{Error, Result};
 use crate::ids::{CellId, InputId, PointId};
@@ -84,10 +85,6 @@ fn parity(perm: &[usize]) -> f64 {
     } else {
         1.0
     }
-}
-
-fn sub<const D: usize>(a: &[f64; D], b: &[f64; D]) -> [f64; D] {
-    std::array::from_fn(|x| a[x] - b[x])
 }
 
 impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> {

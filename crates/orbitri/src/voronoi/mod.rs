@@ -111,6 +111,10 @@ pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
+pub(crate) fn sub<const D: usize>(a: &[f64; D], b: &[f64; D]) -> [f64; D] {
+    std::array::from_fn(|x| a[x] - b[x])
+}
+
 /// Newell's normal of the polygon `vertices[ids]` (twice its vector area; 3D).
 fn newell<const D: usize>(vertices: &[[f64; D]], ids: &[u32]) -> [f64; 3] {
     let mut n = [0.0; 3];
