@@ -1,12 +1,16 @@
 #!/usr/bin/env bash
-# Inputs whose dummy points have large stars: N points on four planes of the unit cube
-# (z = 0, 0.25, 0.5, 0.75; x, y uniform, Python's random seeded with 1), where each dummy
-# point sits alone in the empty slab between two planes. Per repetition, `orbitri
-# triangulate` (build_seconds) and CGAL's `dump3f` (the periodic class with its dummy
-# points, time_s) on the same points. Raw lines go to bench/out/large_holes_raw.txt;
-# medians are printed.
+# Inputs whose dummy points have large stars, Python's random seeded with 1:
+#   planes: N points on four planes of the unit cube (z = 0, 0.25, 0.5, 0.75; x, y
+#           uniform), where each dummy point sits alone in the empty slab between two planes;
+#   slab:   N uniform points in a slab a tenth of the cube thick (z < 0.1) beside a vacuum,
+#           where the last dummy points cannot leave the quotient (the build goes on in the
+#           covering of level 0).
+# Per repetition, `orbitri triangulate` (build_seconds) and CGAL's `dump3f` (the periodic
+# class with its dummy points, time_s) on the same points. Raw lines go to
+# bench/out/large_holes_raw.txt; medians are printed.
 #
 # usage: bench/large_holes.sh [REPS] [N ...]      default: 3 reps, N = 20000 50000 200000
+#        INPUTS="planes slab" (default) chooses the inputs.
 set -euo pipefail
 . "$(dirname "$0")/setup.sh"
 anchor_src=${ANCHOR:-$root/../shared/anchors/cgal}
@@ -17,23 +21,27 @@ shift || true
 ns=${*:-20000 50000 200000}
 raw=$out/large_holes_raw.txt
 stamp="commit=$(git -C "$root" rev-parse --short HEAD) date=$(date -u +%F)"
+for input in ${INPUTS:-planes slab}; do
 for n in $ns; do
-    pts=$out/planes_$n.txt
-    python3 - "$n" "$pts" <<'PY'
+    pts=$out/${input}_$n.txt
+    python3 - "$input" "$n" "$pts" <<'PY'
 import random, sys
-n, path = int(sys.argv[1]), sys.argv[2]
+input, n, path = sys.argv[1], int(sys.argv[2]), sys.argv[3]
 rng = random.Random(1)
 with open(path, "w") as f:
     for i in range(n):
-        f.write("%r %r %r\n" % (rng.random(), rng.random(), 0.25 * (i % 4)))
+        x, y = rng.random(), rng.random()
+        z = 0.25 * (i % 4) if input == "planes" else 0.1 * rng.random()
+        f.write("%r %r %r\n" % (x, y, z))
 PY
     (echo "1 1 1"; cat "$pts") > "$pts.cgal"
     for rep in $(seq "$reps"); do
         line=$("$orb" triangulate "$pts" --box 1 1 1 --stats --format cells -o /dev/null 2>&1)
-        echo "tool=orbitri input=planes N=$n rep=$rep $line $stamp"
+        echo "tool=orbitri input=$input N=$n rep=$rep $line $stamp"
         line=$("$cgal" dump3f "$pts.cgal" /dev/null)
-        echo "tool=cgal input=planes N=$n rep=$rep $line $stamp"
+        echo "tool=cgal input=$input N=$n rep=$rep $line $stamp"
     done
+done
 done | tee -a "$raw" >/dev/null
 python3 - "$raw" "$(git -C "$root" rev-parse --short HEAD)" <<'PY'
 import re, statistics, sys
@@ -43,7 +51,7 @@ for line in open(sys.argv[1]):
         continue
     f = dict(re.findall(r"(\w+)=(\S+)", line))
     t = float(f.get("build_seconds") or f["time_s"])
-    rows.setdefault((int(f["N"]), f["tool"]), []).append(t)
-for (n, tool), ts in sorted(rows.items()):
-    print(f"planes N={n} {tool}: median {statistics.median(ts):.3f} s of {len(ts)}")
+    rows.setdefault((f["input"], int(f["N"]), f["tool"]), []).append(t)
+for (input, n, tool), ts in sorted(rows.items()):
+    print(f"{input} N={n} {tool}: median {statistics.median(ts):.3f} s of {len(ts)}")
 PY

@@ -150,6 +150,55 @@ fn large_holes_on_planes_equal_builds_without_them() {
     check::<3, 4, _>(dicosm, 1.25, "dicosm", false);
 }
 
+/// Points in a thin slab with a vacuum beside it: some dummy points, alone in the vacuum,
+/// cannot leave the quotient without joining two copies of a point, so the triangulation
+/// goes on in the covering of level 0 (lifted, not built again) and comes back to the
+/// quotient if it can. The build equals one through the covering (no dummy point), in
+/// the same number of sheets, and stays dynamic (a removal and an insertion after it give
+/// a fresh build's cells); with weights too.
+#[test]
+fn slabs_beside_a_vacuum_equal_builds_without_dummy_points() {
+    fn check<const D: usize, const N: usize, S: FlatSpace<D, N>>(
+        space: S,
+        pts: &[[f64; D]],
+        sheets: usize,
+        name: &str,
+    ) {
+        let cover = BuildOptions {
+            dummy_threshold: usize::MAX,
+            ..Default::default()
+        };
+        let go = |_| std::ops::ControlFlow::Continue(());
+        let mut tri = Triangulation::<D, N, S>::build(space.clone(), pts).unwrap();
+        let other = Triangulation::<D, N, S>::build_with(space.clone(), pts, cover, go).unwrap();
+        assert!(tri.used_dummy_points(), "{name}");
+        assert_eq!((tri.sheets(), other.sheets()), (sheets, sheets), "{name}");
+        assert!(geometry(&tri) == geometry(&other), "{name}");
+        tri.remove(InputId::new(7)).unwrap();
+        let mut p = pts[3];
+        p[0] = (p[0] + 0.5).fract();
+        tri.insert(p).unwrap();
+        assert!(same_as_fresh(&tri, name), "{name}");
+        let w: Vec<f64> = (0..pts.len()).map(|i| 1e-5 * (i % 7) as f64).collect();
+        let tri = Triangulation::<D, N, S>::build_weighted(space.clone(), pts, &w).unwrap();
+        let other = Triangulation::<D, N, S>::build_weighted_with(space, pts, &w, cover, go);
+        let other = other.unwrap();
+        assert!(tri.used_dummy_points(), "{name}, weighted");
+        assert_eq!(tri.sheets(), other.sheets(), "{name}, weighted");
+        assert!(geometry(&tri) == geometry(&other), "{name}, weighted");
+    }
+    let cube = FlatTorus::cuboid([1.0; 3]).unwrap();
+    check::<3, 4, _>(
+        cube.clone(),
+        &random(1200, 7, [1.0, 1.0, 0.05]),
+        27,
+        "cube, 5 %",
+    );
+    check::<3, 4, _>(cube, &random(1200, 7, [1.0, 1.0, 0.15]), 1, "cube, 15 %");
+    let square = FlatTorus::cuboid([1.0; 2]).unwrap();
+    check::<2, 3, _>(square, &random(1200, 7, [1.0, 0.05]), 1, "square, 5 %");
+}
+
 /// Removing every other point of a large set stays in the quotient, in place, and gives
 /// the fresh build of the other half.
 #[test]

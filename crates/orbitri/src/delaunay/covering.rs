@@ -3,9 +3,9 @@
 //! cycle of length ≤ 2, Theorem 2.2.8), and the way back to level 0.
 
 use std::borrow::Cow;
-use std::collections::HashMap;
 
 use rayon::prelude::*;
+use rustc_hash::FxHashMap;
 
 use super::{Candidate, Engine};
 use crate::ids::{CellId, PointId, VertexId};
@@ -118,7 +118,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.tds.clear();
         self.guaranteed = false;
         self.enter_level(0);
-        let mut facets: HashMap<[VertexId; N], (CellId, usize)> = HashMap::new();
+        let mut facets: FxHashMap<[VertexId; N], (CellId, usize)> = FxHashMap::default();
         for lifted in self.space.anchor_cells() {
             let mut v = lifted.map(|(p, o)| self.vertex_id(PointId(p), o));
             let mut off = lifted.map(|(_, o)| o);
@@ -214,34 +214,28 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
 
     /// True when the projection of the covering triangulation to the quotient is a
     /// simplicial complex: no edge joins two copies of one point, and no two edges join the
-    /// same two points with different relative offsets (no cycle of length ≤ 2).
+    /// same two points with different relative offsets (no cycle of length ≤ 2). The
+    /// covering triangulation is invariant under the group of its sheets, so the star of
+    /// one copy of each point tells (not every cell of every sheet).
     pub fn quotient_is_simplicial(&self) -> bool {
         if self.one_sheeted {
             return true;
         }
-        let mut seen: HashMap<(PointId, PointId), S::Elem> = HashMap::new();
-        for c in self.tds.ids() {
-            let cell = self.tds.cell(c);
-            for a in 0..N {
-                for b in 0..N {
-                    let (pa, pb) = (
-                        self.vpoint[cell.v[a].index()],
-                        self.vpoint[cell.v[b].index()],
-                    );
-                    if a == b {
-                        continue;
-                    }
-                    if pa == pb {
-                        return false;
-                    }
-                    let rel = self.space.relative(cell.off[b], cell.off[a]);
-                    if *seen.entry((pa, pb)).or_insert(rel) != rel {
-                        return false;
-                    }
+        let sheets = self.space.sheets(self.level) as u32;
+        let mut edges: Vec<(PointId, S::Elem)> = Vec::new();
+        (0..self.points.len() as u32).all(|p| {
+            edges.clear();
+            for (c, i, _) in self.star(VertexId(p * sheets)) {
+                let cell = self.tds.cell(c);
+                for k in (0..N).filter(|&k| k != i) {
+                    let rel = self.space.relative(cell.off[k], cell.off[i]);
+                    edges.push((self.vpoint[cell.v[k].index()], rel));
                 }
             }
-        }
-        true
+            edges.sort_unstable();
+            edges.dedup();
+            !edges.iter().any(|e| e.0 == PointId(p)) && !edges.windows(2).any(|w| w[0].0 == w[1].0)
+        })
     }
 
     /// Replaces the covering triangulation by its projection to the space of a later
@@ -256,7 +250,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         // the new cells are created in the order of `reps`: the `k`-th has id `k`
         let mut orbit = vec![CellId::NONE; old.cells.len()];
         let mut reps: Vec<CellId> = Vec::new();
-        let mut index: HashMap<[(PointId, S::Elem); N], CellId> = HashMap::new();
+        let mut index: FxHashMap<[(PointId, S::Elem); N], CellId> = FxHashMap::default();
         for c in old.ids() {
             let key = quotient_key(&self.space, &old_vpoint, &old.cell(c), level);
             orbit[c.index()] = *index.entry(key).or_insert_with(|| {
@@ -279,6 +273,76 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         for k in 0..reps.len() as u32 {
             self.attach(CellId(k));
         }
+        self.hint = CellId(0);
+    }
+
+    /// Replaces the 1-sheeted triangulation of a torus by its lift to the covering of level
+    /// 0, each cell once per sheet: where every point set has a triangulation, so that the
+    /// points whose removal would break the quotient can go (thesis §2.3.1: the dummy points
+    /// left are removed after a conversion to the 27-sheeted covering, not by triangulating
+    /// every point again). The copy of a cell by `t` meets, across each facet, the copy of
+    /// that neighbour by `t` composed with the element between their frames. Every cell is
+    /// counted large (the criterion is examined again only when the quotient is tried).
+    pub(crate) fn unfold(&mut self) {
+        debug_assert!(self.one_sheeted && self.space.translations_only());
+        let ids: Vec<CellId> = self.tds.ids().collect();
+        let mut dense = vec![u32::MAX; self.tds.cells.len()];
+        for (k, c) in ids.iter().enumerate() {
+            dense[c.index()] = k as u32;
+        }
+        // each facet's neighbour, and the sheet of the element from its frame to the cell's
+        let across: Vec<[(u32, usize); N]> = ids
+            .iter()
+            .map(|&c| {
+                std::array::from_fn(|i| {
+                    let d = self.tds.cells[c.index()].n[i];
+                    let g = self.translation(c, i, d);
+                    (dense[d.index()], self.space.sheet_of(g, 0))
+                })
+            })
+            .collect();
+        let old = std::mem::take(&mut self.tds);
+        self.enter_level(0);
+        let sheets = self.copies.len();
+        let mut by_sheet = vec![self.space.identity(); sheets];
+        for &t in &self.copies {
+            by_sheet[self.space.sheet_of(t, 0)] = t;
+        }
+        // the group of the sheets: of translations, the sheet of a sum is the sum of sheets
+        let sum: Vec<usize> = (0..sheets * sheets)
+            .map(|k| {
+                let (a, b) = (by_sheet[k / sheets], by_sheet[k % sheets]);
+                self.space.sheet_of(self.space.compose(a, b), 0)
+            })
+            .collect();
+        self.tds.reserve(ids.len() * sheets);
+        for (a, &c) in ids.iter().enumerate() {
+            let was = old.cell(c);
+            let at = was.off.map(|o| self.space.sheet_of(o, 0));
+            for (s, &t) in by_sheet.iter().enumerate() {
+                let mut cell = Cell::new(was.v, was.off.map(|o| self.space.compose(t, o)));
+                cell.n = std::array::from_fn(|i| {
+                    let (b, g) = across[a][i];
+                    CellId::new(b as usize * sheets + sum[s * sheets + g])
+                });
+                cell.v = std::array::from_fn(|i| {
+                    VertexId::new(was.v[i].index() * sheets + sum[s * sheets + at[i]])
+                });
+                // (a shift by the group of level 0 keeps every sheet)
+                self.canonicalize(&mut cell);
+                debug_assert!((0..N)
+                    .all(|i| { cell.v[i] == self.vertex_id(PointId(was.v[i].0), cell.off[i]) }));
+                let id = self.tds.create(cell);
+                debug_assert_eq!(id.index(), a * sheets + s);
+            }
+        }
+        let n = self.tds.cells.len();
+        for k in 0..n as u32 {
+            self.attach(CellId(k));
+        }
+        self.guaranteed = false;
+        self.big = vec![true; n];
+        self.big_count = n;
         self.hint = CellId(0);
     }
 

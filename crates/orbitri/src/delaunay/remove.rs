@@ -105,19 +105,33 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         (map, true)
     }
 
-    /// Removes points `0..k` (a bulk build's dummy points), largest id first, the last
-    /// point taking each one's id: the other points keep theirs, so only the cells around
-    /// the `k` moved points are rewritten, where renumbering all in order ([`Self::compact`])
-    /// rewrites every cell. Returns, for each id `d < k`, the first id of the point last
-    /// moved into it (a point moves again when fewer than `k` others remain; its new id is
-    /// the smallest that lists it), or `None` when a point cannot go in place (the
-    /// triangulation is then half done: the caller starts again).
+    /// Removes points `0..k` (a bulk build's dummy points), largest id first, those refused
+    /// again after the others; when a round removes none, a torus goes on in the covering
+    /// of level 0 ([`Self::unfold`]), where every removal goes in place. Then the last point
+    /// takes each one's id, largest first: the other points keep theirs, so only the cells
+    /// around the `k` moved points are rewritten, where renumbering all in order
+    /// ([`Self::compact`]) rewrites every cell. Returns, for each id `d < k`, the first id
+    /// of the point last moved into it (a point moves again when fewer than `k` others
+    /// remain; its new id is the smallest that lists it), or `None` when a round removes
+    /// none in the quotient of another space (the triangulation is then half done: the
+    /// caller starts again).
     pub(crate) fn remove_first_points(&mut self, k: usize) -> Option<Vec<PointId>> {
+        // a point whose removal would break the quotient (points in a slab beside a vacuum,
+        // whose dummy points link across it) may go once others have
+        let mut left: Vec<usize> = (0..k).rev().collect();
+        while !left.is_empty() {
+            let before = left.len();
+            left.retain(|&d| !self.remove_copies(PointId::new(d)));
+            if left.len() == before {
+                if !self.one_sheeted || !self.space.translations_only() {
+                    return None;
+                }
+                // (in the covering of level 0 every removal goes in place)
+                self.unfold();
+            }
+        }
         let mut moved = vec![PointId::NONE; k];
         for d in (0..k).rev() {
-            if !self.remove_copies(PointId::new(d)) {
-                return None;
-            }
             let last = self.points.len() - 1;
             self.renumber_last_point(PointId::new(d));
             moved[d] = moved.get(last).copied().unwrap_or(PointId::new(last));
@@ -301,7 +315,8 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 return Err(RemoveError::NotSimplicial);
             }
         } else if breaks || !self.guaranteed {
-            let star_ids: Vec<CellId> = star.iter().map(|s| s.0).collect();
+            let mut star_ids: Vec<CellId> = star.iter().map(|s| s.0).collect();
+            star_ids.sort_unstable();
             if !self.removal_keeps_simplicial(&star_ids, &cells) {
                 return Err(RemoveError::NotSimplicial);
             }
@@ -318,9 +333,9 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         Ok(())
     }
 
-    /// True when replacing the cells `star` by `cells` leaves no cycle of length ≤ 2: at every
-    /// vertex of the new cells, the edges (kept old ones and new ones) reach each neighbour
-    /// with a single offset and never the vertex itself.
+    /// True when replacing the cells `star` (sorted) by `cells` leaves no cycle of length
+    /// ≤ 2: at every vertex of the new cells, the edges (kept old ones and new ones) reach
+    /// each neighbour with a single offset and never the vertex itself.
     fn removal_keeps_simplicial(
         &mut self,
         star: &[CellId],
@@ -349,7 +364,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 let cell = self.tds.cell(c);
                 let i = cell.index_of(a).expect("the star of a vertex holds it");
                 for k in (0..N).filter(|&k| k != i) {
-                    if !star.contains(&c) {
+                    if star.binary_search(&c).is_err() {
                         edges.push((cell.v[k], self.space.relative(cell.off[k], cell.off[i])));
                     }
                     let d = cell.n[k];

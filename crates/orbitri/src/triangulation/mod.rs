@@ -296,6 +296,10 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         if points.len() >= opts.dummy_threshold
             && tri.build_from_dummies(&wrapped_pts, weights, seed, &mut progress)?
         {
+            if !tri.engine.is_one_sheeted() {
+                // (the last dummy points left from the covering of level 0)
+                tri.engine.try_one_sheet();
+            }
             tri.represent_first_occurrences(&wrapped_pts);
             return Ok(tri);
         }
