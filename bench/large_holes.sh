@@ -49,7 +49,10 @@ rows = {}
 for line in open(sys.argv[1]):
     if "commit=" + sys.argv[2] not in line:
         continue
-    f = dict(re.findall(r"(\w+)=(\S+)", line))
+    f = {}
+    for k, v in re.findall(r"(\w+)=(\S+)", line):
+        # (the first of a name: the tool's own `input=` count comes after the script's)
+        f.setdefault(k, v)
     t = float(f.get("build_seconds") or f["time_s"])
     rows.setdefault((f["input"], int(f["N"]), f["tool"]), []).append(t)
 for (input, n, tool), ts in sorted(rows.items()):
