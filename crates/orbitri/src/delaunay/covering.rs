@@ -281,8 +281,8 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// points whose removal would break the quotient can go (thesis §2.3.1: the dummy points
     /// left are removed after a conversion to the 27-sheeted covering, not by triangulating
     /// every point again). The copy of a cell by `t` meets, across each facet, the copy of
-    /// that neighbour by `t` composed with the element between their frames. Every cell is
-    /// counted large (the criterion is examined again only when the quotient is tried).
+    /// that neighbour by `t` composed with the element between their frames; a copy is
+    /// large for the next level's criterion when its cell is.
     pub(crate) fn unfold(&mut self) {
         debug_assert!(self.one_sheeted && self.space.translations_only());
         let ids: Vec<CellId> = self.tds.ids().collect();
@@ -290,7 +290,10 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         for (k, c) in ids.iter().enumerate() {
             dense[c.index()] = k as u32;
         }
-        // each facet's neighbour, and the sheet of the element from its frame to the cell's
+        // each cell's criterion for the level after 0 (its copies are congruent), each
+        // facet's neighbour and the sheet of the element from its frame to the cell's
+        let limit = self.space.criterion_radius2(1.min(self.last_level()));
+        let big: Vec<bool> = ids.iter().map(|&c| self.cell_radius2(c) >= limit).collect();
         let across: Vec<[(u32, usize); N]> = ids
             .iter()
             .map(|&c| {
@@ -341,8 +344,11 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             self.attach(CellId(k));
         }
         self.guaranteed = false;
-        self.big = vec![true; n];
-        self.big_count = n;
+        self.big = big
+            .iter()
+            .flat_map(|&b| std::iter::repeat_n(b, sheets))
+            .collect();
+        self.big_count = self.big.iter().filter(|&&b| b).count();
         self.hint = CellId(0);
     }
 

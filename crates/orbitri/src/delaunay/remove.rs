@@ -121,15 +121,27 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         let mut left: Vec<usize> = (0..k).rev().collect();
         while !left.is_empty() {
             let before = left.len();
-            left.retain(|&d| !self.remove_copies(PointId::new(d)));
+            let mut refused = Vec::new();
+            for &d in &left {
+                if !self.remove_copies(PointId::new(d)) {
+                    if !self.one_sheeted {
+                        // (some of its copies may be gone)
+                        return None;
+                    }
+                    refused.push(d);
+                }
+            }
+            left = refused;
             if left.len() == before {
-                if !self.one_sheeted || !self.space.translations_only() {
+                if !self.space.translations_only() {
                     return None;
                 }
                 // (in the covering of level 0 every removal goes in place)
                 self.unfold();
             }
         }
+        // down the ladder as far as the criterion allows (the quotient is tried after)
+        self.descend();
         let mut moved = vec![PointId::NONE; k];
         for d in (0..k).rev() {
             let last = self.points.len() - 1;
@@ -327,7 +339,8 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         }
         self.commit(&cells);
         self.vcell[v.index()] = CellId::NONE;
-        if !self.guaranteed && self.big_count == 0 {
+        // (in a covering, the criterion's count goes on: `descend` uses it)
+        if self.one_sheeted && !self.guaranteed && self.big_count == 0 {
             self.set_guaranteed(true);
         }
         Ok(())
