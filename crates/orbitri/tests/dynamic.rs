@@ -83,6 +83,38 @@ fn tori2() -> Vec<(&'static str, FlatTorus<2>)> {
     ]
 }
 
+/// The build of `pts` (weighted by `w` if given) and the build through the covering, which
+/// uses no dummy point: the first used its dummy points, and both have the same cells.
+fn built_both_ways<const D: usize, const N: usize, S: FlatSpace<D, N>>(
+    space: &S,
+    pts: &[[f64; D]],
+    w: Option<&[f64]>,
+    name: &str,
+) -> (Triangulation<D, N, S>, Triangulation<D, N, S>) {
+    let cover = BuildOptions {
+        dummy_threshold: usize::MAX,
+        ..Default::default()
+    };
+    let go = |_| std::ops::ControlFlow::Continue(());
+    let (tri, other) = match w {
+        None => (
+            Triangulation::<D, N, S>::build(space.clone(), pts),
+            Triangulation::<D, N, S>::build_with(space.clone(), pts, cover, go),
+        ),
+        Some(w) => (
+            Triangulation::<D, N, S>::build_weighted(space.clone(), pts, w),
+            Triangulation::<D, N, S>::build_weighted_with(space.clone(), pts, w, cover, go),
+        ),
+    };
+    let (tri, other) = (tri.unwrap(), other.unwrap());
+    assert!(
+        tri.used_dummy_points() && !other.used_dummy_points(),
+        "{name}"
+    );
+    assert!(geometry(&tri) == geometry(&other), "{name}");
+    (tri, other)
+}
+
 /// `n` points on four parallel lines (2D) or planes (3D) across the last axis, a quarter
 /// of its length `len` apart, then `lone` points halfway between the first two: every
 /// dummy point (halfway between two planes too) and every lone point has a star of
@@ -111,20 +143,9 @@ fn large_holes_on_planes_equal_builds_without_them() {
         name: &str,
         weighted: bool,
     ) {
-        let cover = BuildOptions {
-            dummy_threshold: usize::MAX,
-            ..Default::default()
-        };
-        let go = |_| std::ops::ControlFlow::Continue(());
         let (n, lone) = (4000, 3);
         let pts = on_planes::<D>(n, lone, len, 5);
-        let mut tri = Triangulation::<D, N, S>::build(space.clone(), &pts).unwrap();
-        let other = Triangulation::<D, N, S>::build_with(space.clone(), &pts, cover, go).unwrap();
-        assert!(
-            tri.used_dummy_points() && !other.used_dummy_points(),
-            "{name}"
-        );
-        assert!(geometry(&tri) == geometry(&other), "{name}");
+        let (mut tri, _) = built_both_ways(&space, &pts, None, name);
         for i in n..n + lone {
             assert_eq!(
                 tri.remove(InputId::new(i)).unwrap(),
@@ -137,11 +158,7 @@ fn large_holes_on_planes_equal_builds_without_them() {
             return;
         }
         let w: Vec<f64> = (0..n + lone).map(|i| 1e-4 * (i % 7) as f64).collect();
-        let tri = Triangulation::<D, N, S>::build_weighted(space.clone(), &pts, &w).unwrap();
-        let other = Triangulation::<D, N, S>::build_weighted_with(space, &pts, &w, cover, go);
-        let other = other.unwrap();
-        assert!(tri.used_dummy_points(), "{name}, weighted");
-        assert!(geometry(&tri) == geometry(&other), "{name}, weighted");
+        built_both_ways(&space, &pts, Some(&w), &format!("{name}, weighted"));
     }
     check::<3, 4, _>(FlatTorus::cuboid([1.0; 3]).unwrap(), 1.0, "cube", true);
     check::<2, 3, _>(FlatTorus::cuboid([1.0; 2]).unwrap(), 1.0, "square", true);
@@ -165,16 +182,8 @@ fn slabs_beside_a_vacuum_equal_builds_without_dummy_points() {
         name: &str,
         weighted: bool,
     ) {
-        let cover = BuildOptions {
-            dummy_threshold: usize::MAX,
-            ..Default::default()
-        };
-        let go = |_| std::ops::ControlFlow::Continue(());
-        let mut tri = Triangulation::<D, N, S>::build(space.clone(), pts).unwrap();
-        let other = Triangulation::<D, N, S>::build_with(space.clone(), pts, cover, go).unwrap();
-        assert!(tri.used_dummy_points(), "{name}");
+        let (mut tri, other) = built_both_ways(&space, pts, None, name);
         assert_eq!((tri.sheets(), other.sheets()), (sheets, sheets), "{name}");
-        assert!(geometry(&tri) == geometry(&other), "{name}");
         tri.remove(InputId::new(7)).unwrap();
         let mut p = pts[3];
         p[0] = (p[0] + 0.5).fract();
@@ -185,12 +194,9 @@ fn slabs_beside_a_vacuum_equal_builds_without_dummy_points() {
             return;
         }
         let w: Vec<f64> = (0..pts.len()).map(|i| 1e-5 * (i % 7) as f64).collect();
-        let tri = Triangulation::<D, N, S>::build_weighted(space.clone(), pts, &w).unwrap();
-        let other = Triangulation::<D, N, S>::build_weighted_with(space, pts, &w, cover, go);
-        let other = other.unwrap();
-        assert!(tri.used_dummy_points(), "{name}, weighted");
-        assert_eq!(tri.sheets(), other.sheets(), "{name}, weighted");
-        assert!(geometry(&tri) == geometry(&other), "{name}, weighted");
+        let name = format!("{name}, weighted");
+        let (tri, other) = built_both_ways(&space, pts, Some(&w), &name);
+        assert_eq!(tri.sheets(), other.sheets(), "{name}");
     }
     let cube = FlatTorus::cuboid([1.0; 3]).unwrap();
     let slab = random(1200, 7, [1.0, 1.0, 0.05]);

@@ -232,9 +232,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                     edges.push((self.vpoint[cell.v[k].index()], rel));
                 }
             }
-            edges.sort_unstable();
-            edges.dedup();
-            !edges.iter().any(|e| e.0 == PointId(p)) && !edges.windows(2).any(|w| w[0].0 == w[1].0)
+            single_edges(PointId(p), &mut edges)
         })
     }
 
@@ -404,6 +402,16 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         }
         self.one_sheeted
     }
+}
+
+/// True when the edges `(neighbour, relative element)` at `own` never reach `own` and reach
+/// each neighbour by a single element: no cycle of length ≤ 2 through it. Sorts `edges`.
+pub(super) fn single_edges<V: Ord, E: Ord>(own: V, edges: &mut [(V, E)]) -> bool {
+    edges.sort_unstable();
+    !edges.iter().any(|e| e.0 == own)
+        && !edges
+            .windows(2)
+            .any(|w| w[0].0 == w[1].0 && w[0].1 != w[1].1)
 }
 
 /// The new ids of the points that stay, in order ([`PointId::NONE`] for the others).

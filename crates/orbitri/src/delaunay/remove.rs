@@ -7,7 +7,7 @@
 
 use std::borrow::Cow;
 
-use super::covering::{drop_gone, renumbering};
+use super::covering::{drop_gone, renumbering, single_edges};
 use super::insert::Refused;
 use super::wrap::{Owner, Wrapped};
 use super::{Candidate, Engine, LiftedCell};
@@ -387,12 +387,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                     }
                 }
             }
-            edges.sort_unstable();
-            if edges.iter().any(|e| e.0 == a)
-                || edges
-                    .windows(2)
-                    .any(|w| w[0].0 == w[1].0 && w[0].1 != w[1].1)
-            {
+            if !single_edges(a, &mut edges) {
                 return false;
             }
         }

@@ -293,23 +293,16 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         let per_point = if D == 3 { 27 } else { 8 };
         tri.engine
             .reserve(points.len() + 128, points.len() * per_point / 4 + 4096);
-        if points.len() >= opts.dummy_threshold
-            && tri.build_from_dummies(&wrapped_pts, weights, seed, &mut progress)?
+        if points.len() < opts.dummy_threshold
+            || !tri.build_from_dummies(&wrapped_pts, weights, seed, &mut progress)?
         {
-            if !tri.engine.is_one_sheeted() {
-                // (the last dummy points left from the covering of level 0)
-                tri.engine.try_one_sheet();
-            }
-            tri.represent_first_occurrences(&wrapped_pts);
-            return Ok(tri);
+            tri = fresh();
+            tri.engine.set_threads(opts.threads);
+            tri.input_point = vec![PointId::NONE; points.len()];
+            tri.insert_ordered((&wrapped_pts, weights), seed, 0, &mut progress, |_, _| true)?;
         }
-        let mut tri = fresh();
-        tri.engine.set_threads(opts.threads);
-        tri.input_point = vec![PointId::NONE; points.len()];
-        tri.insert_ordered((&wrapped_pts, weights), seed, 0, &mut progress, |_, _| true)?;
-        if !tri.engine.is_one_sheeted() {
-            tri.engine.try_one_sheet();
-        }
+        // (a covering: the points' own, or where the last dummy points left)
+        tri.engine.try_one_sheet();
         tri.represent_first_occurrences(&wrapped_pts);
         proceed(&mut progress, points.len())?;
         Ok(tri)
@@ -349,8 +342,8 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     }
 
     /// Dummy-point construction; false if it had to be abandoned (a point coincides with a
-    /// dummy, or the points alone do not satisfy the criterion), `Err` if `progress` stopped
-    /// it.
+    /// dummy, or the last dummies cannot leave the quotient of a space with rotations or
+    /// reflections), `Err` if `progress` stopped it.
     fn build_from_dummies(
         &mut self,
         pts: &[[f64; D]],
@@ -399,7 +392,6 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         self.used_dummies = true;
         // points hidden with the dummies' help come back
         self.uncover();
-        proceed(progress, pts.len())?;
         Ok(true)
     }
 
