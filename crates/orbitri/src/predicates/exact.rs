@@ -8,7 +8,7 @@ use num_traits::{Signed, Zero};
 use super::Sign;
 
 /// Splits a finite double into `(m, e)` with `x = m·2^e` and `m` odd (or zero).
-fn decompose(x: f64) -> (i64, i32) {
+pub(crate) fn decompose(x: f64) -> (i64, i32) {
     if x == 0.0 {
         return (0, 0);
     }

@@ -13,6 +13,7 @@
 pub mod exact;
 pub mod filter;
 pub mod spherical;
+pub mod wide;
 
 /// The sign of a predicate.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]

@@ -10,6 +10,7 @@ use super::{FlatSpace, Lattice, Lifted, OrbitSpace};
 use crate::error::Result;
 use crate::predicates::exact::{self, Scaled};
 use crate::predicates::filter::{self, lifted_diff, plain_diff};
+use crate::predicates::wide;
 use crate::predicates::Sign;
 
 /// An integer offset vector in lattice-vector units (3D).
@@ -157,6 +158,80 @@ impl<const D: usize> FlatTorus<D> {
         )
     }
 
+    /// The differences `s[i] − base` of lifted points and, given weights, `w_i − w_base`, as
+    /// exact integers at one scale (`2^e` for lengths, `2^2e` for weights: no determinant's
+    /// sign sees it), when each difference is below [`wide::LIMIT`]; `None` otherwise (the
+    /// big integers then decide). The fast exact path of the predicates.
+    pub(super) fn small_rows<const K: usize>(
+        &self,
+        s: [&L<D>; K],
+        base: &L<D>,
+        weights: Option<(&[f64; K], f64)>,
+    ) -> Option<([[i64; D]; K], [i128; K])> {
+        let shared = s.iter().all(|x| x.1 == base.1);
+        let m = &self.lattice.rows.m;
+        let exponent = |x: f64| (x != 0.0).then(|| exact::decompose(x).1);
+        let points = s.iter().chain([&base]).flat_map(|x| x.0);
+        let lattice = m.iter().flatten().filter(|_| !shared);
+        let e = points
+            .chain(lattice.copied())
+            .filter_map(exponent)
+            .chain(weights.into_iter().flat_map(|(ws, wb)| {
+                ws.iter()
+                    .copied()
+                    .chain([wb])
+                    .filter_map(move |w| exponent(w).map(|x| x.div_euclid(2)))
+            }))
+            .min()
+            .unwrap_or(0);
+        // `x / 2^scale`, an integer below 2^126 (53 bits shifted by at most 73)
+        let int = |x: f64, scale: i32| -> Option<i128> {
+            if x == 0.0 {
+                return Some(0);
+            }
+            let (mantissa, at) = exact::decompose(x);
+            let shift = at - scale;
+            (shift <= 73).then(|| (mantissa as i128) << shift)
+        };
+        let mut d = [[0i64; D]; K];
+        for (row, p) in d.iter_mut().zip(s) {
+            for c in 0..D {
+                let mut v = int(p.0[c], e)? - int(base.0[c], e)?;
+                if !shared {
+                    for (k, mk) in m.iter().enumerate() {
+                        let t = p.1[k] as i128 - base.1[k] as i128;
+                        if t != 0 {
+                            v = v.checked_add(int(mk[c], e)?.checked_mul(t)?)?;
+                        }
+                    }
+                }
+                if v.unsigned_abs() >= wide::LIMIT as u128 {
+                    return None;
+                }
+                row[c] = v as i64;
+            }
+        }
+        let mut dw = [0i128; K];
+        if let Some((ws, wb)) = weights {
+            for (x, &w) in dw.iter_mut().zip(ws) {
+                *x = int(w, 2 * e)? - int(wb, 2 * e)?;
+            }
+        }
+        Some((d, dw))
+    }
+
+    /// The side of `q` against the (orthogonal) sphere of `s` (`N = D + 1`) without
+    /// perturbation, by [`wide::lifted_side`] when the integers fit ([`Self::small_rows`]).
+    pub(super) fn small_side<const N: usize>(
+        &self,
+        s: &[L<D>; N],
+        q: &L<D>,
+        weights: Option<(&[f64; N], f64)>,
+    ) -> Option<Sign> {
+        let (d, dw) = self.small_rows(std::array::from_fn(|i| &s[i]), q, weights)?;
+        Some(wide::lifted_side(&d, &wide::lifts(&d, &dw)?))
+    }
+
     /// The lifted points as exact integers, all scaled by one power of two.
     pub(super) fn exact_lift(&self, pts: &[L<D>]) -> Vec<[BigInt; D]> {
         self.exact_lift_scaled(pts).0
@@ -214,20 +289,63 @@ impl<const D: usize> FlatTorus<D> {
     ) -> Sign {
         let (d, b) = self.rows::<N>(std::array::from_fn(|i| &s[i]), &q);
         let dw: [f64; N] = std::array::from_fn(|i| ws[i] - wq);
-        filter::power(&d, b, dw).unwrap_or_else(|| self.power_exact(s, ws, q, wq))
+        filter::power(&d, b, dw).unwrap_or_else(|| self.side_exact(s, q, Some((ws, wq))))
     }
 
-    fn power_exact<const N: usize>(&self, s: &[L<D>; N], ws: &[f64; N], q: L<D>, wq: f64) -> Sign {
+    /// The exact orientation of a lifted simplex (`N = D + 1`): the sign of
+    /// `det(s[i] − s[0])`, on fixed-width integers when they fit, else on big ones.
+    pub(super) fn orient_exact<const N: usize>(&self, s: &[L<D>; N]) -> Sign {
+        let rest: [&L<D>; D] = std::array::from_fn(|i| &s[i + 1]);
+        match self.small_rows(rest, &s[0], None) {
+            Some((d, _)) => wide::det_sign(d.each_ref()),
+            None => self.orient_big(s),
+        }
+    }
+
+    fn orient_big<const N: usize>(&self, s: &[L<D>; N]) -> Sign {
+        let l = self.exact_lift(s);
+        let d: [[BigInt; D]; D] =
+            std::array::from_fn(|i| std::array::from_fn(|c| &l[i + 1][c] - &l[0][c]));
+        exact::sign(&exact::det::<D>(d.each_ref()))
+    }
+
+    /// The exact side of `q` against the sphere of `s` (`N = D + 1`), or with weights
+    /// against its orthogonal sphere, without perturbation (see [`exact::lifted_side`]):
+    /// on fixed-width integers when they fit, else on big ones.
+    pub(super) fn side_exact<const N: usize>(
+        &self,
+        s: &[L<D>; N],
+        q: L<D>,
+        weights: Option<(&[f64; N], f64)>,
+    ) -> Sign {
+        self.small_side(s, &q, weights)
+            .unwrap_or_else(|| self.side_big(s, q, weights))
+    }
+
+    fn side_big<const N: usize>(
+        &self,
+        s: &[L<D>; N],
+        q: L<D>,
+        weights: Option<(&[f64; N], f64)>,
+    ) -> Sign {
         let mut pts = s.to_vec();
         pts.push(q);
-        let mut weights = ws.to_vec();
-        weights.push(wq);
+        let weights: Vec<f64> = weights
+            .map(|(ws, wq)| ws.iter().copied().chain([wq]).collect())
+            .unwrap_or_default();
         let (l, w, _) = self.exact_lift_weighted(&pts, &weights);
         let d: Vec<[BigInt; D]> = (0..N)
             .map(|i| std::array::from_fn(|c| &l[i][c] - &l[N][c]))
             .collect();
         let lifts: Vec<BigInt> = (0..N)
-            .map(|i| d[i].iter().map(|x| x * x).sum::<BigInt>() - (&w[i] - &w[N]))
+            .map(|i| {
+                let len = d[i].iter().map(|x| x * x).sum::<BigInt>();
+                if w.is_empty() {
+                    len
+                } else {
+                    len - (&w[i] - &w[N])
+                }
+            })
             .collect();
         exact::lifted_side(&d, &lifts)
     }
@@ -773,7 +891,10 @@ mod tests {
             let wq = random(&mut seed) * 0.3;
             let same = [0.25; N];
             assert_eq!(t.power_test(&s, &same, q, 0.25), t.in_sphere(&s, q));
-            assert_eq!(t.power_raw(&s, &ws, q, wq), t.power_exact(&s, &ws, q, wq));
+            assert_eq!(
+                t.power_raw(&s, &ws, q, wq),
+                t.side_big(&s, q, Some((&ws, wq)))
+            );
             let z = t.orthocenter(&s, &ws);
             let pos = s.map(|x| t.position(x));
             let power = |x: [f64; D], w: f64| -> f64 {
@@ -842,6 +963,67 @@ mod tests {
         stored_checks::<2, 3>(&FlatTorus2::triclinic([[1.0, 0.0], [0.4, 0.8]]).unwrap());
         assert!(stored_checks::<3, 4>(&FlatTorus3::cuboid([1.0; 3]).unwrap()) > 0);
         assert!(stored_checks::<2, 3>(&FlatTorus2::cuboid([1.0; 2]).unwrap()) > 0);
+    }
+
+    /// The fixed-width path decides every orientation and side, weighted or not, as the
+    /// big integers do: on random points, on grid points (exact ties, a non-dyadic grid
+    /// too), with offsets shared or not; points spanning too many binary orders go to the
+    /// big integers. Returns how many were decided small, how many of those were ties, and
+    /// how many went big.
+    fn small_checks<const D: usize, const N: usize>(t: &FlatTorus<D>) -> [usize; 3] {
+        let mut seed = 11u64;
+        let mut counts = [0; 3];
+        for k in 0..6000 {
+            let lifted = |seed: &mut u64| -> L<D> {
+                let x = |seed: &mut u64| match k % 4 {
+                    0 => random(seed),
+                    1 => (random(seed) * 8.0).floor() / 8.0,
+                    2 => (random(seed) * 40.0).floor() / 40.0,
+                    _ if random(seed) < 0.2 => random(seed) * 1e-25,
+                    _ => random(seed),
+                };
+                let o = match k % 3 {
+                    0 => [1; D],
+                    _ => std::array::from_fn(|_| (random(seed) * 3.0) as i8 - 1),
+                };
+                (std::array::from_fn(|_| x(seed)), o)
+            };
+            let s: [L<D>; N] = std::array::from_fn(|_| lifted(&mut seed));
+            let q = lifted(&mut seed);
+            let ws: [f64; N] = std::array::from_fn(|_| (random(&mut seed) * 4.0).floor() / 64.0);
+            let wq = (random(&mut seed) * 4.0).floor() / 64.0;
+            let rest: [&L<D>; D] = std::array::from_fn(|i| &s[i + 1]);
+            match t.small_rows(rest, &s[0], None) {
+                Some((d, _)) => assert_eq!(wide::det_sign(d.each_ref()), t.orient_big(&s)),
+                None => counts[2] += 1,
+            }
+            for weights in [None, Some((&ws, wq))] {
+                let want = t.side_big(&s, q, weights);
+                if let Some(side) = t.small_side(&s, &q, weights) {
+                    assert_eq!(side, want, "{s:?} {q:?} {weights:?}");
+                    counts[0] += 1;
+                    counts[1] += (want == Sign::Zero) as usize;
+                }
+            }
+        }
+        counts
+    }
+
+    #[test]
+    fn small_integers_decide_as_big_ones() {
+        let tri3 = FlatTorus3::triclinic([[1.0, 0.0, 0.0], [0.3, 0.9, 0.0], [0.2, -0.1, 1.1]]);
+        let tri2 = FlatTorus2::triclinic([[1.0, 0.0], [0.4, 0.8]]);
+        for [small, ties, big] in [
+            small_checks::<3, 4>(&tri3.unwrap()),
+            small_checks::<2, 3>(&tri2.unwrap()),
+            small_checks::<3, 4>(&FlatTorus3::cuboid([1.0; 3]).unwrap()),
+            small_checks::<2, 3>(&FlatTorus2::cuboid([0.7, 1.3]).unwrap()),
+        ] {
+            assert!(
+                small > 4000 && ties > 10 && big > 200,
+                "{small} {ties} {big}"
+            );
+        }
     }
 
     #[test]

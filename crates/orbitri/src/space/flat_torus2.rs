@@ -8,7 +8,6 @@ use super::flat_torus::{
     flat_torus_plugin, lift, UnperturbedInSphere, CENTER_TOLERANCE, L, RADIUS_TOLERANCE,
 };
 use super::{FlatTorus, OrbitSpace};
-use crate::predicates::exact;
 use crate::predicates::filter;
 use crate::predicates::Sign;
 
@@ -30,29 +29,11 @@ impl FlatTorus<2> {
         })
     }
 
-    fn orient_exact(&self, s: &[L2; 3]) -> Sign {
-        let l = self.exact_lift(s);
-        let d: Vec<[BigInt; 2]> = (1..3)
-            .map(|i| std::array::from_fn(|c| &l[i][c] - &l[0][c]))
-            .collect();
-        exact::sign(&(&d[0][0] * &d[1][1] - &d[0][1] * &d[1][0]))
-    }
-
-    fn in_circle_exact(&self, s: &[L2; 3], q: L2) -> Sign {
-        let l = self.exact_lift(&[s[0], s[1], s[2], q]);
-        let d: Vec<[BigInt; 2]> = (0..3)
-            .map(|i| std::array::from_fn(|c| &l[i][c] - &l[3][c]))
-            .collect();
-        let len: Vec<BigInt> = d.iter().map(|r| &r[0] * &r[0] + &r[1] * &r[1]).collect();
-        let m = |a: usize, b: usize| &d[a][0] * &d[b][1] - &d[a][1] * &d[b][0];
-        exact::sign(&(&len[0] * m(1, 2) - &len[1] * m(0, 2) + &len[2] * m(0, 1)))
-    }
-
     /// The in-circle sign without perturbation (`Zero` when cocircular), exact.
     #[inline(always)]
     fn in_sphere_raw(&self, s: &[L2; 3], q: L2) -> Sign {
         let (d, b) = self.rows([&s[0], &s[1], &s[2]], &q);
-        filter::in_circle(&d, b).unwrap_or_else(|| self.in_circle_exact(s, q))
+        filter::in_circle(&d, b).unwrap_or_else(|| self.side_exact(s, q, None))
     }
 }
 

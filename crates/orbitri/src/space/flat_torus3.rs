@@ -7,7 +7,6 @@ use super::flat_torus::{
     flat_torus_plugin, lift, UnperturbedInSphere, CENTER_TOLERANCE, L, RADIUS_TOLERANCE,
 };
 use super::{FlatTorus, OrbitSpace};
-use crate::predicates::exact;
 use crate::predicates::filter;
 use crate::predicates::Sign;
 
@@ -39,36 +38,11 @@ impl FlatTorus<3> {
         })
     }
 
-    fn orient_exact(&self, s: &[L3; 4]) -> Sign {
-        let l = self.exact_lift(s);
-        let d: Vec<[BigInt; 3]> = (1..4)
-            .map(|i| std::array::from_fn(|c| &l[i][c] - &l[0][c]))
-            .collect();
-        exact::sign(&exact::det3(&d[0], &d[1], &d[2]))
-    }
-
-    fn in_sphere_exact(&self, s: &[L3; 4], q: L3) -> Sign {
-        let pts = [s[0], s[1], s[2], s[3], q];
-        let l = self.exact_lift(&pts);
-        let d: Vec<[BigInt; 3]> = (0..4)
-            .map(|i| std::array::from_fn(|c| &l[i][c] - &l[4][c]))
-            .collect();
-        let len: Vec<BigInt> = d
-            .iter()
-            .map(|r| &r[0] * &r[0] + &r[1] * &r[1] + &r[2] * &r[2])
-            .collect();
-        let det = -&len[0] * exact::det3(&d[1], &d[2], &d[3])
-            + &len[1] * exact::det3(&d[0], &d[2], &d[3])
-            - &len[2] * exact::det3(&d[0], &d[1], &d[3])
-            + &len[3] * exact::det3(&d[0], &d[1], &d[2]);
-        exact::sign(&det).flip()
-    }
-
     /// The in-sphere sign without perturbation (`Zero` when cospherical), exact.
     #[inline(always)]
     fn in_sphere_raw(&self, s: &[L3; 4], q: L3) -> Sign {
         let (d, b) = self.rows([&s[0], &s[1], &s[2], &s[3]], &q);
-        filter::in_sphere3(&d, b).unwrap_or_else(|| self.in_sphere_exact(s, q))
+        filter::in_sphere3(&d, b).unwrap_or_else(|| self.side_exact(s, q, None))
     }
 }
 
