@@ -1,16 +1,20 @@
 #!/usr/bin/env bash
-# Inputs whose dummy points have large stars, Python's random seeded with 1:
+# Degenerate inputs, Python's random seeded with 1:
 #   planes: N points on four planes of the unit cube (z = 0, 0.25, 0.5, 0.75; x, y
 #           uniform), where each dummy point sits alone in the empty slab between two planes;
 #   slab:   N uniform points in a slab a tenth of the cube thick (z < 0.1) beside a vacuum,
 #           where the last dummy points cannot leave the quotient (the build goes on in the
-#           covering of level 0).
+#           covering of level 0);
+#   sc, bcc, fcc: the simple, body-centred and face-centred cubic crystals filling the
+#           unit cube with about N atoms (k³, 2k³, 4k³ for the k nearest), where every
+#           Delaunay sphere passes through 8 (sc), 4 (bcc) or 6 (fcc) atoms and most
+#           in-sphere tests are exact ties.
 # Per repetition, `orbitri triangulate` (build_seconds) and CGAL's `dump3f` (the periodic
 # class with its dummy points, time_s) on the same points. Raw lines go to
 # bench/out/large_holes_raw.txt; medians are printed.
 #
-# usage: bench/large_holes.sh [REPS] [N ...]      default: 3 reps, N = 20000 50000 200000
-#        INPUTS="planes slab" (default) chooses the inputs.
+# usage: bench/degenerate.sh [REPS] [N ...]      default: 3 reps, N = 20000 50000 200000
+#        INPUTS="planes slab" (default) chooses the inputs, e.g. INPUTS="sc bcc fcc".
 set -euo pipefail
 . "$(dirname "$0")/setup.sh"
 anchor_src=${ANCHOR:-$root/../shared/anchors/cgal}
@@ -28,8 +32,17 @@ for n in $ns; do
 import random, sys
 input, n, path = sys.argv[1], int(sys.argv[2]), sys.argv[3]
 rng = random.Random(1)
+basis = {"sc": [(0, 0, 0)], "bcc": [(0, 0, 0), (.5, .5, .5)],
+         "fcc": [(0, 0, 0), (.5, .5, 0), (.5, 0, .5), (0, .5, .5)]}
 with open(path, "w") as f:
-    for i in range(n):
+    if input in basis:
+        k = round((n / len(basis[input])) ** (1 / 3))
+        for i in range(k):
+            for j in range(k):
+                for l in range(k):
+                    for a, b, c in basis[input]:
+                        f.write("%r %r %r\n" % ((i + a) / k, (j + b) / k, (l + c) / k))
+    for i in range(0 if input in basis else n):
         x, y = rng.random(), rng.random()
         z = 0.25 * (i % 4) if input == "planes" else 0.1 * rng.random()
         f.write("%r %r %r\n" % (x, y, z))
