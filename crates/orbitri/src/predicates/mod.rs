@@ -58,7 +58,8 @@ pub(crate) fn perturbed_by<T: Copy, const N: usize>(
     orient: impl Fn(&[T; N]) -> Sign,
     compare: impl Fn(usize, usize) -> Sign,
 ) -> Sign {
-    let mut order: Vec<usize> = (0..=N).collect();
+    let mut all = [0, 1, 2, 3, 4, 5, 6, 7];
+    let order = &mut all[..=N];
     for i in 1..=N {
         let mut j = i;
         while j > 0 && compare(order[j - 1], order[j]) == Sign::Positive {

@@ -7,8 +7,10 @@
 //! Bounds, with `|d| < 2⁶²`: a product of two coordinates is below 2¹²⁴, a 2×2 minor
 //! below 2¹²⁵ and a squared length (up to three terms) below 2¹²⁶, all within `i128`;
 //! lifts `|d|² − Δw` are asked to stay below 2¹²⁶ too. A 3×3 determinant is below
-//! 3·2⁶²·2¹²⁵ < 2¹⁸⁹, a lifted term below 2¹²⁶·2¹⁸⁹ and the sum of four below 2³¹⁷: five
-//! 64-bit limbs in two's complement hold every intermediate value.
+//! 3·2⁶²·2¹²⁵ < 2¹⁸⁹, held as `hi·2⁶⁴ + lo` with an `i128` high part; a lifted term is
+//! below 2¹²⁶·2¹⁸⁹ = 2³¹⁵, and the lifted determinant's positive terms and its negative
+//! ones are summed apart, as magnitudes of five 64-bit limbs (each sum below 2³¹⁷), then
+//! compared.
 
 use super::Sign;
 
@@ -18,104 +20,83 @@ pub const LIMIT: i128 = 1 << 62;
 /// The exclusive bound on the magnitude of a lift `|d|² − Δw` this module takes.
 pub const LIFT_LIMIT: i128 = 1 << 126;
 
-/// A signed integer of 320 bits in two's complement, least significant limb first.
+/// A signed integer below 2¹⁹¹ in magnitude, `hi·2⁶⁴ + lo`: a 3×3 determinant.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-struct Wide([u64; 5]);
+struct I192 {
+    hi: i128,
+    lo: u64,
+}
 
-impl Wide {
-    fn from_i128(x: i128) -> Wide {
-        let ext = if x < 0 { u64::MAX } else { 0 };
-        Wide([x as u64, (x >> 64) as u64, ext, ext, ext])
-    }
-
-    fn is_negative(&self) -> bool {
-        (self.0[4] as i64) < 0
-    }
-
-    fn neg(self) -> Wide {
-        let mut out = [0; 5];
-        let mut carry = true;
-        for (o, &x) in out.iter_mut().zip(&self.0) {
-            let (v, c) = (!x).overflowing_add(carry as u64);
-            *o = v;
-            carry = c;
-        }
-        Wide(out)
-    }
-
-    fn add(self, other: Wide) -> Wide {
-        let mut out = [0; 5];
-        let mut carry = false;
-        for i in 0..5 {
-            let (v, c1) = self.0[i].overflowing_add(other.0[i]);
-            let (v, c2) = v.overflowing_add(carry as u64);
-            out[i] = v;
-            carry = c1 || c2;
-        }
-        Wide(out)
-    }
-
-    /// `self · x`, which must fit (the bounds above).
+impl I192 {
+    /// `x·m` for `|m| < 2¹²⁷`: `m = (m >> 64)·2⁶⁴ + (m mod 2⁶⁴)`, each part's product
+    /// within `i128`.
     #[inline(always)]
-    fn mul(self, x: i128) -> Wide {
-        let negative = self.is_negative() != (x < 0);
-        let a = if self.is_negative() { self.neg() } else { self };
-        let b = x.unsigned_abs();
-        let b = [b as u64, (b >> 64) as u64];
-        let mut out = [0u64; 5];
-        for i in 0..5 {
-            if a.0[i] == 0 {
-                continue;
-            }
-            let mut carry = 0u128;
-            for j in 0..2.min(5 - i) {
-                let t = a.0[i] as u128 * b[j] as u128 + out[i + j] as u128 + carry;
-                out[i + j] = t as u64;
-                carry = t >> 64;
-            }
-            if i + 2 < 5 {
-                out[i + 2] = carry as u64;
-            }
-        }
-        let p = Wide(out);
-        if negative {
-            p.neg()
-        } else {
-            p
+    fn product(x: i64, m: i128) -> I192 {
+        let low = x as i128 * (m as u64) as i128;
+        let high = x as i128 * (m >> 64);
+        I192 {
+            hi: high + (low >> 64),
+            lo: low as u64,
         }
     }
 
-    fn sign(&self) -> Sign {
-        if self.is_negative() {
-            Sign::Negative
-        } else if self.0.iter().all(|&x| x == 0) {
-            Sign::Zero
-        } else {
-            Sign::Positive
+    #[inline(always)]
+    fn add(self, other: I192) -> I192 {
+        let (lo, carry) = self.lo.overflowing_add(other.lo);
+        I192 {
+            hi: self.hi + other.hi + carry as i128,
+            lo,
+        }
+    }
+
+    #[inline(always)]
+    fn neg(self) -> I192 {
+        I192 {
+            hi: -self.hi - (self.lo != 0) as i128,
+            lo: self.lo.wrapping_neg(),
+        }
+    }
+
+    /// The sign and the magnitude's limbs, least significant first.
+    #[inline(always)]
+    fn split(self) -> (bool, [u64; 3]) {
+        let negative = self.hi < 0;
+        let m = if negative { self.neg() } else { self };
+        (negative, [m.lo, m.hi as u64, (m.hi >> 64) as u64])
+    }
+
+    fn sign(self) -> Sign {
+        match self.hi.cmp(&0) {
+            std::cmp::Ordering::Less => Sign::Negative,
+            std::cmp::Ordering::Equal if self.lo == 0 => Sign::Zero,
+            _ => Sign::Positive,
         }
     }
 }
 
 /// `a·d − b·c` of coordinates below [`LIMIT`].
-#[inline]
+#[inline(always)]
 fn minor(a: i64, b: i64, c: i64, d: i64) -> i128 {
     a as i128 * d as i128 - b as i128 * c as i128
 }
 
 /// The determinant of `D` rows (`D` 2 or 3) of coordinates below [`LIMIT`].
 #[inline(always)]
-fn det<const D: usize>(rows: [&[i64; D]; D]) -> Wide {
+fn det<const D: usize>(rows: [&[i64; D]; D]) -> I192 {
     let r = |i: usize, c: usize| rows[i][c];
     if D == 2 {
-        return Wide::from_i128(minor(r(0, 0), r(0, 1), r(1, 0), r(1, 1)));
+        let m = minor(r(0, 0), r(0, 1), r(1, 0), r(1, 1));
+        return I192 {
+            hi: m >> 64,
+            lo: m as u64,
+        };
     }
     let m12 = minor(r(1, 1), r(1, 2), r(2, 1), r(2, 2));
     let m02 = minor(r(1, 0), r(1, 2), r(2, 0), r(2, 2));
     let m01 = minor(r(1, 0), r(1, 1), r(2, 0), r(2, 1));
-    Wide::from_i128(m12)
-        .mul(r(0, 0) as i128)
-        .add(Wide::from_i128(m02).mul(r(0, 1) as i128).neg())
-        .add(Wide::from_i128(m01).mul(r(0, 2) as i128))
+    I192::product(r(0, 0), m12)
+        .add(I192::product(r(0, 1), m02).neg())
+        .add(I192::product(r(0, 2), m01))
 }
 
 /// The sign of the determinant of `D` rows (`D` 2 or 3) below [`LIMIT`].
@@ -123,20 +104,45 @@ pub fn det_sign<const D: usize>(rows: [&[i64; D]; D]) -> Sign {
     det(rows).sign()
 }
 
+/// Adds the product of magnitudes `a·b` to the 320-bit magnitude `acc` (which must hold it).
+#[inline(always)]
+fn add_product(acc: &mut [u64; 5], a: u128, b: [u64; 3]) {
+    for (i, &x) in [a as u64, (a >> 64) as u64].iter().enumerate() {
+        let mut carry = 0u128;
+        for (j, &y) in b.iter().enumerate() {
+            let t = x as u128 * y as u128 + acc[i + j] as u128 + carry;
+            acc[i + j] = t as u64;
+            carry = t >> 64;
+        }
+        for slot in &mut acc[i + 3..] {
+            let t = *slot as u128 + carry;
+            *slot = t as u64;
+            carry = t >> 64;
+        }
+    }
+}
+
 /// [`super::exact::lifted_side`] on rows below [`LIMIT`] and lifts below [`LIFT_LIMIT`]:
-/// the sign of the `(D+1)×(D+1)` determinant of rows `(d_i, l_i)` times `(−1)^D`.
+/// the sign of the `(D+1)×(D+1)` determinant of rows `(d_i, l_i)` times `(−1)^D`. The
+/// positive and the negative terms are summed apart, as magnitudes, and compared.
 pub fn lifted_side<const D: usize, const N: usize>(d: &[[i64; D]; N], l: &[i128; N]) -> Sign {
     debug_assert_eq!(N, D + 1);
-    let mut total = Wide::from_i128(0);
+    let mut sums = [[0u64; 5]; 2];
     for i in 0..N {
         let mut rows = [&d[0]; D];
         for (slot, k) in (0..N).filter(|&k| k != i).enumerate() {
             rows[slot] = &d[k];
         }
-        let term = det::<D>(rows).mul(l[i]);
-        total = total.add(if (i + D) & 1 == 0 { term } else { term.neg() });
+        let (negative, m) = det::<D>(rows).split();
+        let odd = (i + D) & 1 == 1;
+        add_product(
+            &mut sums[(negative ^ (l[i] < 0) ^ odd) as usize],
+            l[i].unsigned_abs(),
+            m,
+        );
     }
-    let s = total.sign();
+    let [plus, minus] = sums;
+    let s = Sign::from(plus.iter().rev().cmp(minus.iter().rev()));
     if D & 1 == 0 {
         s
     } else {
@@ -171,16 +177,8 @@ mod tests {
     use num_bigint::BigInt;
     use proptest::prelude::*;
 
-    fn big(w: Wide) -> BigInt {
-        let mut v = BigInt::from(0);
-        for &x in w.0.iter().rev() {
-            v = (v << 64usize) + BigInt::from(x);
-        }
-        if w.is_negative() {
-            v - (BigInt::from(1) << 320usize)
-        } else {
-            v
-        }
+    fn big(x: I192) -> BigInt {
+        (BigInt::from(x.hi) << 64usize) + BigInt::from(x.lo)
     }
 
     fn near_limit() -> impl Strategy<Value = i64> {
@@ -192,23 +190,38 @@ mod tests {
         d.iter().map(|r| r.map(BigInt::from)).collect()
     }
 
+    fn big_lifts<const N: usize>(l: &[i128; N]) -> Vec<BigInt> {
+        l.iter().map(|&x| BigInt::from(x)).collect()
+    }
+
     proptest! {
         #[test]
-        fn products_and_sums_are_those_of_big_integers(a in any::<i128>(), b in any::<i64>(), c in any::<i128>()) {
-            let p = Wide::from_i128(a).mul(b as i128);
-            prop_assert_eq!(big(p), BigInt::from(a) * BigInt::from(b));
-            let s = Wide::from_i128(a).add(Wide::from_i128(c).neg());
-            prop_assert_eq!(big(s), BigInt::from(a) - BigInt::from(c));
-            let q = Wide::from_i128(a >> 2).mul(c >> 2).mul(b as i128 >> 2);
-            prop_assert_eq!(big(q), BigInt::from(a >> 2) * BigInt::from(c >> 2) * BigInt::from(b >> 2));
+        fn products_and_sums_are_those_of_big_integers(
+            x in any::<i64>(), m in any::<i128>(), y in any::<i64>(), n in any::<i128>(),
+            a in any::<u128>(), b in prop::array::uniform3(any::<u64>()),
+        ) {
+            let (p, q) = (I192::product(x, m >> 1), I192::product(y, n >> 1));
+            prop_assert_eq!(big(p), BigInt::from(x) * BigInt::from(m >> 1));
+            prop_assert_eq!(big(p.add(q.neg())), big(p) - big(q));
+            let (negative, limbs) = p.split();
+            let magnitude = limbs.iter().rev().fold(BigInt::from(0), |v, &l| (v << 64usize) + l);
+            prop_assert_eq!(if negative { -magnitude } else { magnitude }, big(p));
+            let mut acc = [u64::MAX >> 2, 7, 0, 0, 0];
+            add_product(&mut acc, a >> 2, [b[0], b[1], b[2] >> 3]);
+            let sum = acc.iter().rev().fold(BigInt::from(0), |v, &l| (v << 64usize) + l);
+            let b = (BigInt::from(b[2] >> 3) << 128usize) + (BigInt::from(b[1]) << 64usize) + b[0];
+            prop_assert_eq!(sum, BigInt::from(a >> 2) * b + (BigInt::from(7) << 64usize) + (u64::MAX >> 2));
         }
 
         #[test]
-        fn lifted_sides_are_those_of_big_integers_3d(d in prop::array::uniform4(prop::array::uniform3(near_limit()))) {
-            let l = d.map(|r| squared_length(&r));
-            let bl: Vec<BigInt> = l.iter().map(|&x| BigInt::from(x)).collect();
-            prop_assert_eq!(lifted_side(&d, &l), exact::lifted_side::<3>(&big_rows(&d), &bl));
+        fn lifted_sides_are_those_of_big_integers_3d(
+            d in prop::array::uniform4(prop::array::uniform3(near_limit())),
+            w in prop::array::uniform4(-(1i128 << 125)..(1i128 << 125)),
+        ) {
             let b = big_rows(&d);
+            for l in [lifts(&d, &[0; 4]).unwrap(), w] {
+                prop_assert_eq!(lifted_side(&d, &l), exact::lifted_side::<3>(&b, &big_lifts(&l)));
+            }
             prop_assert_eq!(det_sign([&d[0], &d[1], &d[2]]), exact::sign(&exact::det3(&b[0], &b[1], &b[2])));
         }
 
@@ -217,10 +230,9 @@ mod tests {
             d in prop::array::uniform3(prop::array::uniform2(near_limit())),
             w in prop::array::uniform3(-(1i128 << 100)..(1i128 << 100)),
         ) {
-            let l: [i128; 3] = std::array::from_fn(|i| squared_length(&d[i]) - w[i]);
-            let bl: Vec<BigInt> = l.iter().map(|&x| BigInt::from(x)).collect();
-            prop_assert_eq!(lifted_side(&d, &l), exact::lifted_side::<2>(&big_rows(&d), &bl));
+            let l = lifts(&d, &w).unwrap();
             let b = big_rows(&d);
+            prop_assert_eq!(lifted_side(&d, &l), exact::lifted_side::<2>(&b, &big_lifts(&l)));
             prop_assert_eq!(det_sign([&d[0], &d[1]]), exact::sign(&exact::det::<2>([&b[0], &b[1]])));
         }
     }
@@ -230,11 +242,11 @@ mod tests {
         // every row at the limit, signs chosen to make each term as large as it gets
         let m = (LIMIT - 1) as i64;
         let d = [[m, -m, m], [-m, -m, m], [m, m, m], [-m, m, -m]];
-        let l = d.map(|r| squared_length(&r));
-        let bl: Vec<BigInt> = l.iter().map(|&x| BigInt::from(x)).collect();
+        let b = big_rows(&d);
+        let l = lifts(&d, &[0; 4]).unwrap();
         assert_eq!(
             lifted_side(&d, &l),
-            exact::lifted_side::<3>(&big_rows(&d), &bl)
+            exact::lifted_side::<3>(&b, &big_lifts(&l))
         );
         let l = [
             LIFT_LIMIT - 1,
@@ -242,14 +254,13 @@ mod tests {
             LIFT_LIMIT - 1,
             -(LIFT_LIMIT - 1),
         ];
-        let bl: Vec<BigInt> = l.iter().map(|&x| BigInt::from(x)).collect();
         assert_eq!(
             lifted_side(&d, &l),
-            exact::lifted_side::<3>(&big_rows(&d), &bl)
+            exact::lifted_side::<3>(&b, &big_lifts(&l))
         );
-        assert_eq!(
-            big(Wide::from_i128(i128::MIN).mul(i128::MIN)),
-            BigInt::from(i128::MIN).pow(2)
-        );
+        assert_eq!(lifts(&d, &[-(LIFT_LIMIT / 2); 4]), None);
+        // a tie: four points on a circle about the origin's row
+        let t = [[1, 0, 0], [0, 1, 0], [-1, 0, 0], [0, -1, 0]];
+        assert_eq!(lifted_side(&t, &lifts(&t, &[0; 4]).unwrap()), Sign::Zero);
     }
 }

@@ -426,16 +426,15 @@ impl<const D: usize> FlatTorus<D> {
     /// invariant under lattice translations, which makes the perturbation the same for every
     /// periodic copy.
     pub fn compare_lifted(&self, a: L<D>, b: L<D>) -> Sign {
+        if a.1 == b.1 {
+            let c = (0..D).find(|&c| a.0[c] != b.0[c]);
+            return c.map_or(Sign::Zero, |c| Sign::from(a.0[c].total_cmp(&b.0[c])));
+        }
         let (d, _) = lifted_diff(&self.lattice.rows, &a.0, widen(a.1), &b.0, widen(b.1));
-        let same_offset = a.1 == b.1;
+        let dt: [i32; D] = std::array::from_fn(|k| a.1[k] as i32 - b.1[k] as i32);
+        let (_, abs) = self.lattice.rows.apply(dt);
         for c in 0..D {
-            let decided = if same_offset {
-                a.0[c].partial_cmp(&b.0[c]).map(Sign::from)
-            } else {
-                let dt: [i32; D] = std::array::from_fn(|k| a.1[k] as i32 - b.1[k] as i32);
-                let (_, abs) = self.lattice.rows.apply(dt);
-                filter::component(d[c], (a.0[c] - b.0[c]).abs() + abs[c])
-            };
+            let decided = filter::component(d[c], (a.0[c] - b.0[c]).abs() + abs[c]);
             let sign = decided.unwrap_or_else(|| {
                 let l = self.exact_lift(&[a, b]);
                 exact::sign(&(&l[0][c] - &l[1][c]))
