@@ -58,6 +58,7 @@ pub(crate) fn perturbed_by<T: Copy, const N: usize>(
     orient: impl Fn(&[T; N]) -> Sign,
     compare: impl Fn(usize, usize) -> Sign,
 ) -> Sign {
+    const { assert!(N < 8) };
     let mut all = [0, 1, 2, 3, 4, 5, 6, 7];
     let order = &mut all[..=N];
     for i in 1..=N {

@@ -83,6 +83,7 @@ fn minor(a: i64, b: i64, c: i64, d: i64) -> i128 {
 /// The determinant of `D` rows (`D` 2 or 3) of coordinates below [`LIMIT`].
 #[inline(always)]
 fn det<const D: usize>(rows: [&[i64; D]; D]) -> I192 {
+    const { assert!(D == 2 || D == 3) };
     let r = |i: usize, c: usize| rows[i][c];
     if D == 2 {
         let m = minor(r(0, 0), r(0, 1), r(1, 0), r(1, 1));
@@ -259,8 +260,14 @@ mod tests {
             exact::lifted_side::<3>(&b, &big_lifts(&l))
         );
         assert_eq!(lifts(&d, &[-(LIFT_LIMIT / 2); 4]), None);
-        // a tie: four points on a circle about the origin's row
-        let t = [[1, 0, 0], [0, 1, 0], [-1, 0, 0], [0, -1, 0]];
+        // a tie: four points (not on one plane) on the unit sphere about (1, 0, 0), which
+        // passes through the query at the origin; the centre as query is inside
+        let t = [[2, 0, 0], [1, 1, 0], [1, 0, 1], [1, -1, 0]];
         assert_eq!(lifted_side(&t, &lifts(&t, &[0; 4]).unwrap()), Sign::Zero);
+        let centred = t.map(|r| [r[0] - 1, r[1], r[2]]);
+        let l = lifts(&centred, &[0; 4]).unwrap();
+        let want = exact::lifted_side::<3>(&big_rows(&centred), &big_lifts(&l));
+        assert_ne!(want, Sign::Zero);
+        assert_eq!(lifted_side(&centred, &l), want);
     }
 }
