@@ -924,6 +924,16 @@ mod tests {
         assert!(decided > 1000);
     }
 
+    /// A lifted point of test `k` with coordinates drawn by `x`: offset `[1; D]` (shared by
+    /// every point of the test) when `k % 3 == 0`, else random in `−1..=1`.
+    fn lifted_point<const D: usize>(seed: &mut u64, k: usize, x: impl Fn(&mut u64) -> f64) -> L<D> {
+        let o = match k % 3 {
+            0 => [1; D],
+            _ => std::array::from_fn(|_| (random(seed) * 3.0) as i8 - 1),
+        };
+        (std::array::from_fn(|_| x(seed)), o)
+    }
+
     /// The predicates on stored points equal those on lifted copies, with offsets shared
     /// or not, on random points and on points of a quarter grid (cospherical ties).
     fn stored_checks<const D: usize, const N: usize>(t: &FlatTorus<D>) -> usize
@@ -934,15 +944,10 @@ mod tests {
         let mut ties = 0;
         for k in 0..4000 {
             let lifted = |seed: &mut u64| -> L<D> {
-                let x = |seed: &mut u64| match k % 2 {
+                lifted_point(seed, k, |seed| match k % 2 {
                     0 => random(seed),
                     _ => (random(seed) * 4.0).floor() / 4.0,
-                };
-                let o = match k % 3 {
-                    0 => [1; D],
-                    _ => std::array::from_fn(|_| (random(seed) * 3.0) as i8 - 1),
-                };
-                (std::array::from_fn(|_| x(seed)), o)
+                })
             };
             let s: [L<D>; N] = std::array::from_fn(|_| lifted(&mut seed));
             let q = lifted(&mut seed);
@@ -976,18 +981,13 @@ mod tests {
         let mut counts = [0; 4];
         for k in 0..6000 {
             let lifted = |seed: &mut u64| -> L<D> {
-                let x = |seed: &mut u64| match k % 4 {
+                lifted_point(seed, k, |seed| match k % 4 {
                     0 => random(seed),
                     1 => (random(seed) * 8.0).floor() / 8.0,
                     2 => (random(seed) * 40.0).floor() / 40.0,
                     _ if random(seed) < 0.2 => random(seed) * 1e-25,
                     _ => random(seed),
-                };
-                let o = match k % 3 {
-                    0 => [1; D],
-                    _ => std::array::from_fn(|_| (random(seed) * 3.0) as i8 - 1),
-                };
-                (std::array::from_fn(|_| x(seed)), o)
+                })
             };
             let s: [L<D>; N] = std::array::from_fn(|_| lifted(&mut seed));
             let q = lifted(&mut seed);
