@@ -171,20 +171,12 @@ impl<const D: usize> FlatTorus<D> {
     ) -> Option<([[i64; D]; K], [i128; K])> {
         let shared = s.iter().all(|x| x.1 == base.1);
         let m = &self.lattice.rows.m;
-        let exponent = |x: f64| (x != 0.0).then(|| exact::decompose(x).1);
         let points = s.iter().chain([&base]).flat_map(|x| x.0);
-        let lattice = m.iter().flatten().filter(|_| !shared);
-        let e = points
-            .chain(lattice.copied())
-            .filter_map(exponent)
-            .chain(weights.into_iter().flat_map(|(ws, wb)| {
-                ws.iter()
-                    .copied()
-                    .chain([wb])
-                    .filter_map(move |w| exponent(w).map(|x| x.div_euclid(2)))
-            }))
-            .min()
-            .unwrap_or(0);
+        let lattice = m.iter().flatten().copied().filter(|_| !shared);
+        let squares = weights
+            .into_iter()
+            .flat_map(|(ws, wb)| ws.iter().copied().chain([wb]));
+        let e = Scaled::with_squares(points.chain(lattice), squares).exponent();
         // `x / 2^scale` when it is an integer below 2^126 in magnitude
         let int = |x: f64, scale: i32| -> Option<i128> {
             if x == 0.0 {
