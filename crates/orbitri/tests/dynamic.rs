@@ -129,11 +129,12 @@ fn on_planes<const D: usize>(n: usize, lone: usize, len: f64, seed: u64) -> Vec<
         .collect()
 }
 
-/// The large holes of points on planes (the dummy points' when they leave, the lone
-/// points' when removed), filled by gift wrapping through its index of the candidates
-/// (each apex found so is checked against trying every candidate in debug builds): the
-/// build equals one through the covering, which removes no dummy point, and removing the
-/// lone points gives a fresh build of the others. Weighted points too (on the tori), and a
+/// Points on planes: the dummy points leave early (after a BRIO round, once the planes
+/// are dense enough for the criterion), and the lone points' large holes are filled by
+/// gift wrapping through its index of the candidates (each apex found so is checked
+/// against trying every candidate in debug builds): the build equals one through the
+/// covering, which removes no dummy point, and removing the lone points gives a fresh
+/// build of the others. Weighted points too (on the tori), and a
 /// manifold (whose holes are wrapped without the index).
 #[test]
 fn large_holes_on_planes_equal_builds_without_them() {

@@ -117,8 +117,9 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// caller starts again).
     pub(crate) fn remove_first_points(&mut self, k: usize) -> Option<Vec<PointId>> {
         // a point whose removal would break the quotient (points in a slab beside a vacuum,
-        // whose dummy points link across it) may go once others have
-        let mut left: Vec<usize> = (0..k).rev().collect();
+        // whose dummy points link across it) may go once others have; those that left
+        // early (`Self::dummies_leave`) are gone
+        let mut left: Vec<usize> = (0..k).rev().filter(|&d| self.has_vertex(d)).collect();
         while !left.is_empty() {
             let before = left.len();
             let mut refused = Vec::new();
@@ -149,6 +150,31 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             moved[d] = moved.get(last).copied().unwrap_or(PointId::new(last));
         }
         Some(moved)
+    }
+
+    /// During a bulk build from the dummy points `0..k`: those still there whose removal
+    /// keeps the switch criterion leave now, while their stars are small (points on a few
+    /// planes give each dummy, alone in the slab between two, a star that grows with the
+    /// planes: wrapped at the end, its hole holds thousands of vertices). Nothing happens
+    /// unless the criterion holds in the quotient, and it still holds after: each removal
+    /// whose new cells would be too large for it is refused. Returns how many left.
+    pub(crate) fn dummies_leave(&mut self, k: usize) -> usize {
+        if !(self.one_sheeted && self.guaranteed) {
+            return 0;
+        }
+        let mut gone = 0;
+        for d in (0..k).rev() {
+            if self.has_vertex(d) && self.remove_vertex_keeping(VertexId::new(d), true).is_ok() {
+                gone += 1;
+            }
+        }
+        gone
+    }
+
+    /// True when point `d` of the 1-sheeted triangulation has a vertex (a dummy point that
+    /// has not left).
+    fn has_vertex(&self, d: usize) -> bool {
+        self.vcell[self.vertex_of_point(PointId::new(d)).index()] != CellId::NONE
     }
 
     /// Removes every vertex of point `p` (one per sheet), which must not be the only point.
@@ -278,6 +304,12 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// the criterion of its level (level 0 is a triangulation for every point set that
     /// keeps a copy of each other point). Otherwise nothing changes.
     pub(crate) fn remove_vertex(&mut self, v: VertexId) -> Result<(), RemoveError> {
+        self.remove_vertex_keeping(v, false)
+    }
+
+    /// [`Self::remove_vertex`]; with `criterion`, refused also in the quotient when the new
+    /// cells break the switch criterion.
+    fn remove_vertex_keeping(&mut self, v: VertexId, criterion: bool) -> Result<(), RemoveError> {
         let star = self.star(v);
         let shifted = |e: &Self, c: CellId, shift: S::Elem| -> LiftedCell<S, N> {
             e.lifted_cell(c)
@@ -322,7 +354,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         let limit = self.space.criterion_radius2(self.level);
         let breaks =
             limit.is_finite() && cells.iter().any(|w| self.radius2(&w.arr, &w.vids) >= limit);
-        if !self.one_sheeted {
+        if !self.one_sheeted || criterion {
             if breaks {
                 return Err(RemoveError::NotSimplicial);
             }
@@ -397,7 +429,75 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
 
 #[cfg(test)]
 mod tests {
-    use crate::delaunay::uniform_cube;
+    use std::collections::BTreeSet;
+
+    use crate::delaunay::{uniform_cube, Engine};
+    use crate::sort::SplitMix;
+    use crate::space::{FlatTorus3, OrbitSpace};
+
+    /// Every cell as its points' coordinates (bits) and offsets, sorted, the first offset
+    /// translated to zero: comparable whatever the point ids and the cells' storage.
+    fn geometry(e: &Engine<FlatTorus3, 4>) -> BTreeSet<Vec<([u64; 3], [i8; 3])>> {
+        e.tds
+            .ids()
+            .map(|c| {
+                let mut cell: Vec<([u64; 3], [i8; 3])> = e
+                    .lifted_cell(c)
+                    .iter()
+                    .map(|(p, o)| (p.map(f64::to_bits), *o))
+                    .collect();
+                cell.sort_unstable();
+                let o = cell[0].1;
+                cell.iter()
+                    .map(|&(p, q)| (p, [0, 1, 2].map(|i| q[i] - o[i])))
+                    .collect()
+            })
+            .collect()
+    }
+
+    /// Dummy points leave a bulk build early only when the switch criterion still holds
+    /// after: on four planes, dense enough, all of them; in a slab beside a vacuum, not
+    /// those alone in the vacuum (a second try removes none and changes nothing). Every
+    /// cell is then within the criterion, and the dummies' removal at the end skips those
+    /// gone and gives the triangulation of the points alone.
+    #[test]
+    fn dummy_points_leave_early_only_when_the_criterion_stays() {
+        let space = FlatTorus3::cuboid([1.0; 3]).unwrap();
+        for (name, slab) in [("planes", None), ("slab", Some(0.05))] {
+            let mut e = Engine::new(space.clone());
+            e.points = space.dummy_points();
+            let k = e.points.len();
+            e.bootstrap_one_sheeted();
+            let mut r = SplitMix::new(3);
+            let pts: Vec<[f64; 3]> = (0..2000)
+                .map(|i| {
+                    let z = slab.map_or(0.25 * (i % 4) as f64, |t| t * r.unit());
+                    [r.unit(), r.unit(), z]
+                })
+                .collect();
+            for &p in &pts {
+                e.insert(p);
+            }
+            let gone = e.dummies_leave(k);
+            match slab {
+                None => assert_eq!(gone, k, "{name}"),
+                Some(_) => assert!(0 < gone && gone < k, "{name}: {gone} of {k} left"),
+            }
+            assert!(e.one_sheeted && e.guaranteed, "{name}");
+            let limit = e.space.criterion_radius2(e.level);
+            assert!(e.tds.ids().all(|c| e.cell_radius2(c) < limit), "{name}");
+            let cells = geometry(&e);
+            assert_eq!(e.dummies_leave(k), 0, "{name}");
+            assert!(geometry(&e) == cells, "{name}");
+            assert!(e.remove_first_points(k).is_some(), "{name}");
+            e.is_valid().unwrap();
+            let mut fresh = Engine::new(space.clone());
+            for &p in &pts {
+                fresh.insert(p);
+            }
+            assert!(geometry(&e) == geometry(&fresh), "{name}");
+        }
+    }
 
     /// The first `k` points leave and the last take their ids, the others keep theirs; the
     /// map names each moved point's first id, also when points move twice (fewer than `k`

@@ -201,6 +201,29 @@ fn hilbert_order<const D: usize, const N: usize, S: FlatSpace<D, N>>(
     order
 }
 
+/// The dummy points of a bulk build (points `0..k`) leave as soon as their removal keeps
+/// the switch criterion, tried after each BRIO round from `8k` points on, while their stars
+/// are small; after a try that removes none from `64k` points on, they wait for the end
+/// (points in a slab beside a vacuum, whose dummies there never leave the quotient).
+struct Leaving {
+    k: usize,
+    trying: bool,
+}
+
+impl Leaving {
+    fn new(k: usize) -> Self {
+        Leaving { k, trying: k > 0 }
+    }
+
+    /// After a round, `done` points inserted.
+    fn after_round<S: OrbitSpace<N>, const N: usize>(&mut self, e: &mut Engine<S, N>, done: usize) {
+        if self.trying && done >= 8 * self.k {
+            let gone = e.dummies_leave(self.k);
+            self.trying = gone > 0 || done < 64 * self.k;
+        }
+    }
+}
+
 /// Reports progress `k` to the build's callback: `Err(Interrupted)` if it asks to stop.
 fn proceed(progress: &mut impl FnMut(usize) -> ControlFlow<()>, k: usize) -> Result<()> {
     match progress(k) {
@@ -299,7 +322,13 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
             tri = fresh();
             tri.engine.set_threads(opts.threads);
             tri.input_point = vec![PointId::NONE; points.len()];
-            tri.insert_ordered((&wrapped_pts, weights), seed, 0, &mut progress, |_, _| true)?;
+            tri.insert_ordered(
+                (&wrapped_pts, weights),
+                seed,
+                (0, 0),
+                &mut progress,
+                |_, _| true,
+            )?;
         }
         // (a covering: the points' own, or where the last dummy points left)
         tri.engine.try_one_sheet();
@@ -369,10 +398,16 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         self.point_input = vec![InputId::NONE; k as usize];
         // (a dummy hidden by a point on it, of a larger weight, or a point on a dummy: start
         // again without)
-        let kept = self.insert_ordered((pts, weights), seed, 0, progress, |r, hid| match r {
-            Inserted::Duplicate(p) => p.0 >= k,
-            _ => hid.iter().all(|h| h.id.0 >= k),
-        })?;
+        let kept = self.insert_ordered(
+            (pts, weights),
+            seed,
+            (0, k as usize),
+            progress,
+            |r, hid| match r {
+                Inserted::Duplicate(p) => p.0 >= k,
+                _ => hid.iter().all(|h| h.id.0 >= k),
+            },
+        )?;
         if !kept {
             return Ok(false);
         }
@@ -423,12 +458,13 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     /// round at a time, each sorted on a helper thread while the ones before it are
     /// inserted ([`crate::sort::in_rounds`]); records each in the engine's order while
     /// `keep(result, points it hid)` holds: false when one does not (the rest unrecorded),
-    /// `Err` if `progress` stopped it.
+    /// `Err` if `progress` stopped it. The first `dummies` points of the engine are a
+    /// build's dummy points, which leave between rounds when they can ([`Leaving`]).
     fn insert_ordered(
         &mut self,
         (points, weights): (&[[f64; D]], &[f64]),
         seed: Option<u64>,
-        first: usize,
+        (first, dummies): (usize, usize),
         progress: &mut impl FnMut(usize) -> ControlFlow<()>,
         keep: impl Fn(Inserted, &[HiddenPoint<[f64; D]>]) -> bool,
     ) -> Result<bool> {
@@ -445,6 +481,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         };
         let order = seed.map(|seed| Brio::new(seed, growth));
         let mut done = 0;
+        let mut leaving = Leaving::new(dummies);
         let outcome = crate::sort::in_rounds(
             points.len(),
             order,
@@ -455,6 +492,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
                 match self.insert_round((points, weights), &round, at, progress, &keep) {
                     Ok(true) => {
                         done += round.len();
+                        leaving.after_round(&mut self.engine, done);
                         Ok(())
                     }
                     Ok(false) => Err(None),
@@ -603,7 +641,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         let done = self.insert_ordered(
             (internal, weights),
             Some(seed),
-            first,
+            (first, 0),
             unstoppable,
             |_, _| true,
         );
