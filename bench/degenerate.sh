@@ -5,6 +5,10 @@
 #   slab:   N uniform points in a slab a tenth of the cube thick (z < 0.1) beside a vacuum,
 #           where the last dummy points cannot leave the quotient (the build goes on in the
 #           covering of level 0);
+#   lines:  N points on 16 lines of the unit cube along x (y, z on a 4 x 4 grid), where
+#           each dummy point sits alone in the empty tube between four lines;
+#   shell:  N points in a hollow spherical shell (radius 0.3 to 0.31 about the centre),
+#           where the dummy points inside have every point of the shell in their link;
 #   sc, bcc, fcc: the simple, body-centred and face-centred cubic crystals filling the
 #           unit cube with about N atoms (k³, 2k³, 4k³ for the k nearest), where every
 #           Delaunay sphere passes through 8 (sc), 4 (bcc) or 6 (fcc) atoms and most
@@ -14,7 +18,8 @@
 # bench/out/large_holes_raw.txt; medians are printed.
 #
 # usage: bench/degenerate.sh [REPS] [N ...]      default: 3 reps, N = 20000 50000 200000
-#        INPUTS="planes slab" (default) chooses the inputs, e.g. INPUTS="sc bcc fcc".
+#        INPUTS="planes slab" (default) chooses the inputs, e.g. INPUTS="sc bcc fcc" or
+#        INPUTS="lines shell".
 set -euo pipefail
 . "$(dirname "$0")/setup.sh"
 anchor_src=${ANCHOR:-$root/../shared/anchors/cgal}
@@ -42,7 +47,15 @@ with open(path, "w") as f:
                 for l in range(k):
                     for a, b, c in basis[input]:
                         f.write("%r %r %r\n" % ((i + a) / k, (j + b) / k, (l + c) / k))
-    for i in range(0 if input in basis else n):
+    for i in range(n if input in ("lines", "shell") else 0):
+        if input == "lines":
+            p = (rng.random(), 0.25 * (i % 4) + 0.1, 0.25 * (i // 4 % 4) + 0.1)
+        else:
+            v = [rng.gauss(0, 1) for _ in range(3)]
+            r = sum(c * c for c in v) ** 0.5
+            p = tuple(0.5 + (0.3 + 0.01 * rng.random()) * c / r for c in v)
+        f.write("%r %r %r\n" % p)
+    for i in range(0 if input in basis or input in ("lines", "shell") else n):
         x, y = rng.random(), rng.random()
         z = 0.25 * (i % 4) if input == "planes" else 0.1 * rng.random()
         f.write("%r %r %r\n" % (x, y, z))
