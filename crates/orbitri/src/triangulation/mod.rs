@@ -201,23 +201,29 @@ fn hilbert_order<const D: usize, const N: usize, S: FlatSpace<D, N>>(
     order
 }
 
-/// The dummy points of a bulk build (points `0..k`) leave as soon as their removal keeps
-/// the switch criterion, tried after each BRIO round from `8k` points on, while their stars
-/// are small; after a try that removes none from `64k` points on, they wait for the end
-/// (points in a slab beside a vacuum, whose dummies there never leave the quotient).
+/// The dummy points of a bulk build (points `0..k`) of `n` points leave as soon as their
+/// removal keeps the switch criterion, tried after each BRIO round from `8k` points on,
+/// while their stars are small, but not after the last (the build's end removes them);
+/// after a try that removes none from `64k` points on, they wait for the end (points in a
+/// slab beside a vacuum, whose dummies there never leave the quotient).
 struct Leaving {
     k: usize,
+    n: usize,
     trying: bool,
 }
 
 impl Leaving {
-    fn new(k: usize) -> Self {
-        Leaving { k, trying: k > 0 }
+    fn new(k: usize, n: usize) -> Self {
+        Leaving {
+            k,
+            n,
+            trying: k > 0,
+        }
     }
 
     /// After a round, `done` points inserted.
     fn after_round<S: OrbitSpace<N>, const N: usize>(&mut self, e: &mut Engine<S, N>, done: usize) {
-        if self.trying && done >= 8 * self.k {
+        if self.trying && done >= 8 * self.k && done < self.n {
             let gone = e.dummies_leave(self.k);
             self.trying = gone > 0 || done < 64 * self.k;
         }
@@ -257,8 +263,9 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     }
 
     /// Bulk construction: spatial sort (BRIO + Hilbert); for large inputs start from the
-    /// dummy point set in the 1-sheeted torus and remove the dummies at the end, otherwise
-    /// (or if removing a dummy would break the criterion) insert into the covering space.
+    /// dummy point set in the 1-sheeted torus and remove the dummies as soon as the points
+    /// keep the switch criterion without them (after a round) or at the end, otherwise (or
+    /// if removing a dummy would break the criterion) insert into the covering space.
     ///
     /// `progress` is called with the number of points inserted so far: before the first,
     /// every 4096 points (with threads: after each wave, the
@@ -481,7 +488,7 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         };
         let order = seed.map(|seed| Brio::new(seed, growth));
         let mut done = 0;
-        let mut leaving = Leaving::new(dummies);
+        let mut leaving = Leaving::new(dummies, points.len());
         let outcome = crate::sort::in_rounds(
             points.len(),
             order,
@@ -1282,6 +1289,45 @@ fn canonical<
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The dummy points try to leave after a round only from `8k` points on and not after
+    /// the last; on four planes all leave at the first try; beside a vacuum, where some
+    /// stay, a try that removes none ends the tries only from `64k` points on.
+    #[test]
+    fn dummy_points_leave_after_the_rounds_the_policy_names() {
+        let space = FlatTorus::<3>::cuboid([1.0; 3]).unwrap();
+        let start = |slab: Option<f64>| {
+            let mut e = Engine::new(space.clone());
+            e.points = space.dummy_points();
+            e.bootstrap_one_sheeted();
+            let mut r = crate::sort::SplitMix::new(3);
+            for i in 0..2000 {
+                let z = slab.map_or(0.25 * (i % 4) as f64, |t| t * r.unit());
+                e.insert([r.unit(), r.unit(), z]);
+            }
+            e
+        };
+        let k = space.dummy_points().len();
+        let there =
+            |e: &Engine<FlatTorus<3>, 4>| (0..k).filter(|&d| e.vcell[d] != CellId::NONE).count();
+        let mut e = start(None);
+        Leaving::new(k, 2000).after_round(&mut e, 2000);
+        assert_eq!(there(&e), k, "after the last round");
+        let mut planes = Leaving::new(k, 10_000);
+        planes.after_round(&mut e, 8 * k - 1);
+        assert_eq!(there(&e), k, "before 8k points");
+        planes.after_round(&mut e, 8 * k);
+        assert_eq!(there(&e), 0, "planes");
+        let mut e = start(Some(0.05));
+        let mut slab = Leaving::new(k, 100_000);
+        slab.after_round(&mut e, 8 * k);
+        let stay = there(&e);
+        assert!(0 < stay && stay < k && slab.trying, "slab: {stay} stay");
+        slab.after_round(&mut e, 64 * k - 1);
+        assert!(slab.trying, "a try that removes none before 64k points");
+        slab.after_round(&mut e, 64 * k);
+        assert!(!slab.trying && there(&e) == stay, "slab");
+    }
 
     /// Each point at its first occurrence and each hidden input, in input order: the same
     /// list as sorting the points by their first occurrence with the hidden inputs, after
