@@ -47,18 +47,17 @@ with open(path, "w") as f:
                 for l in range(k):
                     for a, b, c in basis[input]:
                         f.write("%r %r %r\n" % ((i + a) / k, (j + b) / k, (l + c) / k))
-    for i in range(n if input in ("lines", "shell") else 0):
+    for i in range(0 if input in basis else n):
         if input == "lines":
             p = (rng.random(), 0.25 * (i % 4) + 0.1, 0.25 * (i // 4 % 4) + 0.1)
-        else:
+        elif input == "shell":
             v = [rng.gauss(0, 1) for _ in range(3)]
             r = sum(c * c for c in v) ** 0.5
             p = tuple(0.5 + (0.3 + 0.01 * rng.random()) * c / r for c in v)
+        else:
+            x, y = rng.random(), rng.random()
+            p = (x, y, 0.25 * (i % 4) if input == "planes" else 0.1 * rng.random())
         f.write("%r %r %r\n" % p)
-    for i in range(0 if input in basis or input in ("lines", "shell") else n):
-        x, y = rng.random(), rng.random()
-        z = 0.25 * (i % 4) if input == "planes" else 0.1 * rng.random()
-        f.write("%r %r %r\n" % (x, y, z))
 PY
     (echo "1 1 1"; cat "$pts") > "$pts.cgal"
     for rep in $(seq "$reps"); do

@@ -744,6 +744,31 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     }
 }
 
+/// A unit cube torus started from its dummy points, then 2000 points (seed 3) inserted one
+/// at a time: on the four planes `z = 0, 1/4, 1/2, 3/4`, or with `slab = Some(t)` uniform
+/// in the slab `z < t` beside a vacuum. With the points: the start of the tests of the
+/// dummy points' early leaving.
+#[cfg(test)]
+pub(crate) fn from_dummies(
+    slab: Option<f64>,
+) -> (Engine<crate::space::FlatTorus3, 4>, Vec<[f64; 3]>) {
+    let space = crate::space::FlatTorus3::cuboid([1.0; 3]).unwrap();
+    let mut e = Engine::new(space.clone());
+    e.points = space.dummy_points();
+    e.bootstrap_one_sheeted();
+    let mut r = SplitMix::new(3);
+    let pts: Vec<[f64; 3]> = (0..2000)
+        .map(|i| {
+            let z = slab.map_or(0.25 * (i % 4) as f64, |t| t * r.unit());
+            [r.unit(), r.unit(), z]
+        })
+        .collect();
+    for &p in &pts {
+        e.insert(p);
+    }
+    (e, pts)
+}
+
 /// A unit cube torus with `n` uniform random points (seed `seed`) inserted one at a time:
 /// the engine the module's unit tests start from.
 #[cfg(test)]

@@ -173,7 +173,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
 
     /// True when point `d` of the 1-sheeted triangulation has a vertex (a dummy point that
     /// has not left).
-    fn has_vertex(&self, d: usize) -> bool {
+    pub(crate) fn has_vertex(&self, d: usize) -> bool {
         self.vcell[self.vertex_of_point(PointId::new(d)).index()] != CellId::NONE
     }
 
@@ -431,8 +431,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
 mod tests {
     use std::collections::BTreeSet;
 
-    use crate::delaunay::{uniform_cube, Engine};
-    use crate::sort::SplitMix;
+    use crate::delaunay::{from_dummies, uniform_cube, Engine};
     use crate::space::{FlatTorus3, OrbitSpace};
 
     /// Every cell as its points' coordinates (bits) and offsets, sorted, the first offset
@@ -462,22 +461,9 @@ mod tests {
     /// gone and gives the triangulation of the points alone.
     #[test]
     fn dummy_points_leave_early_only_when_the_criterion_stays() {
-        let space = FlatTorus3::cuboid([1.0; 3]).unwrap();
         for (name, slab) in [("planes", None), ("slab", Some(0.05))] {
-            let mut e = Engine::new(space.clone());
-            e.points = space.dummy_points();
-            let k = e.points.len();
-            e.bootstrap_one_sheeted();
-            let mut r = SplitMix::new(3);
-            let pts: Vec<[f64; 3]> = (0..2000)
-                .map(|i| {
-                    let z = slab.map_or(0.25 * (i % 4) as f64, |t| t * r.unit());
-                    [r.unit(), r.unit(), z]
-                })
-                .collect();
-            for &p in &pts {
-                e.insert(p);
-            }
+            let (mut e, pts) = from_dummies(slab);
+            let k = e.space.dummy_points().len();
             let gone = e.dummies_leave(k);
             match slab {
                 None => assert_eq!(gone, k, "{name}"),
@@ -491,7 +477,7 @@ mod tests {
             assert!(geometry(&e) == cells, "{name}");
             assert!(e.remove_first_points(k).is_some(), "{name}");
             e.is_valid().unwrap();
-            let mut fresh = Engine::new(space.clone());
+            let mut fresh = Engine::new(e.space.clone());
             for &p in &pts {
                 fresh.insert(p);
             }

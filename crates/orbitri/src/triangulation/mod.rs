@@ -1295,22 +1295,10 @@ mod tests {
     /// stay, a try that removes none ends the tries only from `64k` points on.
     #[test]
     fn dummy_points_leave_after_the_rounds_the_policy_names() {
-        let space = FlatTorus::<3>::cuboid([1.0; 3]).unwrap();
-        let start = |slab: Option<f64>| {
-            let mut e = Engine::new(space.clone());
-            e.points = space.dummy_points();
-            e.bootstrap_one_sheeted();
-            let mut r = crate::sort::SplitMix::new(3);
-            for i in 0..2000 {
-                let z = slab.map_or(0.25 * (i % 4) as f64, |t| t * r.unit());
-                e.insert([r.unit(), r.unit(), z]);
-            }
-            e
-        };
-        let k = space.dummy_points().len();
-        let there =
-            |e: &Engine<FlatTorus<3>, 4>| (0..k).filter(|&d| e.vcell[d] != CellId::NONE).count();
-        let mut e = start(None);
+        use crate::delaunay::from_dummies;
+        let (mut e, _) = from_dummies(None);
+        let k = e.space().dummy_points().len();
+        let there = |e: &Engine<FlatTorus<3>, 4>| (0..k).filter(|&d| e.has_vertex(d)).count();
         Leaving::new(k, 2000).after_round(&mut e, 2000);
         assert_eq!(there(&e), k, "after the last round");
         let mut planes = Leaving::new(k, 10_000);
@@ -1318,7 +1306,7 @@ mod tests {
         assert_eq!(there(&e), k, "before 8k points");
         planes.after_round(&mut e, 8 * k);
         assert_eq!(there(&e), 0, "planes");
-        let mut e = start(Some(0.05));
+        let (mut e, _) = from_dummies(Some(0.05));
         let mut slab = Leaving::new(k, 100_000);
         slab.after_round(&mut e, 8 * k);
         let stay = there(&e);
