@@ -15,7 +15,7 @@ use crate::tds::Cell;
 impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// The vertex id of the lifted copy `(p, o)` at the current level: `sheets` ids per
     /// point, sheet by sheet (the point id itself in the quotient).
-    fn vertex_id(&self, p: PointId, o: S::Elem) -> VertexId {
+    pub(super) fn vertex_id(&self, p: PointId, o: S::Elem) -> VertexId {
         let sheets = self.space.sheets(self.level) as u32;
         VertexId(p.0 * sheets + self.space.sheet_of(o, self.level) as u32)
     }
@@ -222,18 +222,21 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             return true;
         }
         let sheets = self.space.sheets(self.level) as u32;
-        let mut edges: Vec<(PointId, S::Elem)> = Vec::new();
-        (0..self.points.len() as u32).all(|p| {
-            edges.clear();
-            for (c, i, _) in self.star(VertexId(p * sheets)) {
-                let cell = self.tds.cell(c);
-                for k in (0..N).filter(|&k| k != i) {
-                    let rel = self.space.relative(cell.off[k], cell.off[i]);
-                    edges.push((self.vpoint[cell.v[k].index()], rel));
+        (0..self.points.len() as u32)
+            .into_par_iter()
+            .with_min_len(1024)
+            .map_init(Vec::new, |edges: &mut Vec<(PointId, S::Elem)>, p| {
+                edges.clear();
+                for (c, i, _) in self.star(VertexId(p * sheets)) {
+                    let cell = self.tds.cell(c);
+                    for k in (0..N).filter(|&k| k != i) {
+                        let rel = self.space.relative(cell.off[k], cell.off[i]);
+                        edges.push((self.vpoint[cell.v[k].index()], rel));
+                    }
                 }
-            }
-            single_edges(PointId(p), &mut edges)
-        })
+                single_edges(PointId(p), edges)
+            })
+            .all(|single| single)
     }
 
     /// Replaces the covering triangulation by its projection to the space of a later
@@ -246,22 +249,70 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         let old = std::mem::take(&mut self.tds);
         let old_vpoint = std::mem::take(&mut self.vpoint);
         // the new cells are created in the order of `reps`: the `k`-th has id `k`
-        let mut orbit = vec![CellId::NONE; old.cells.len()];
         let mut reps: Vec<CellId> = Vec::new();
+        let mut orbit = vec![CellId::NONE; old.cells.len()];
+        // Into the quotient of a torus, the group of the sheets moves each cell onto one
+        // cell for each sheet of its vertex of least point (two copies of a point share no
+        // cell when the quotient is simplicial): the one with that vertex in sheet 0 stands
+        // for its orbit, which its vertex ids moved that way name. Only those are hashed,
+        // and only the neighbours that do not stand for their own orbit are looked up.
+        let free = level == self.last_level() && self.space.translations_only();
+        let sheets = self.space.sheets(self.level) as u32;
+        let sum = if free {
+            self.sheet_group().1
+        } else {
+            Vec::new()
+        };
+        let to_first: Vec<u32> = (0..sum.len().isqrt())
+            .map(|a| (0..sheets as usize).position(|b| sum[b * sheets as usize + a] == 0))
+            .map(|b| b.unwrap_or(0) as u32)
+            .collect();
+        let least = |v: &[VertexId; N]| v[(0..N).min_by_key(|&i| v[i].0 / sheets).unwrap_or(0)];
+        let class = |c: CellId| {
+            let v = old.cells[c.index()].v;
+            let g = to_first[(least(&v).0 % sheets) as usize] * sheets;
+            let mut k = v.map(|u| u.0 - u.0 % sheets + sum[(g + u.0 % sheets) as usize] as u32);
+            k.sort_unstable();
+            k
+        };
+        let mut named: FxHashMap<[u32; N], CellId> = FxHashMap::default();
         let mut index: FxHashMap<[(PointId, S::Elem); N], CellId> = FxHashMap::default();
         for c in old.ids() {
-            let key = quotient_key(&self.space, &old_vpoint, &old.cell(c), level);
-            orbit[c.index()] = *index.entry(key).or_insert_with(|| {
-                reps.push(c);
-                CellId::new(reps.len() - 1)
-            });
+            let k = CellId::new(reps.len());
+            if free {
+                if least(&old.cells[c.index()].v).0 % sheets == 0 {
+                    let fresh = named.insert(class(c), k).is_none();
+                    debug_assert!(
+                        fresh,
+                        "one cell of an orbit has its least vertex in sheet 0"
+                    );
+                    orbit[c.index()] = k;
+                    reps.push(c);
+                }
+            } else {
+                let key = quotient_key(&self.space, &old_vpoint, &old.cell(c), level);
+                orbit[c.index()] = *index.entry(key).or_insert_with(|| {
+                    reps.push(c);
+                    k
+                });
+            }
         }
+        let orbit_of = |d: CellId| match orbit[d.index()] {
+            CellId::NONE => named[&class(d)],
+            k => k,
+        };
+        let cells: Vec<Cell<S::Elem, N>> = reps
+            .iter()
+            .map(|&c| {
+                let was = old.cell(c);
+                let mut cell = Cell::new(was.v, was.off);
+                cell.n = was.n.map(orbit_of);
+                cell
+            })
+            .collect();
         self.enter_level(level);
         self.tds.reserve(reps.len());
-        for &c in &reps {
-            let was = old.cell(c);
-            let mut cell = Cell::new(was.v, was.off);
-            cell.n = was.n.map(|d| orbit[d.index()]);
+        for mut cell in cells {
             // in the new level's canonical form, then renumbered for its sheets
             self.canonicalize(&mut cell);
             cell.v =
@@ -305,17 +356,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         let old = std::mem::take(&mut self.tds);
         self.enter_level(0);
         let sheets = self.copies.len();
-        let mut by_sheet = vec![self.space.identity(); sheets];
-        for &t in &self.copies {
-            by_sheet[self.space.sheet_of(t, 0)] = t;
-        }
-        // the group of the sheets: of translations, the sheet of a sum is the sum of sheets
-        let sum: Vec<usize> = (0..sheets * sheets)
-            .map(|k| {
-                let (a, b) = (by_sheet[k / sheets], by_sheet[k % sheets]);
-                self.space.sheet_of(self.space.compose(a, b), 0)
-            })
-            .collect();
+        let (by_sheet, sum) = self.sheet_group();
         self.tds.reserve(ids.len() * sheets);
         for (a, &c) in ids.iter().enumerate() {
             let was = old.cell(c);
@@ -348,6 +389,23 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             .collect();
         self.big_count = self.big.iter().filter(|&&b| b).count();
         self.hint = CellId(0);
+    }
+
+    /// The copies of the current level by sheet, and the group of the sheets: of
+    /// translations, the sheet of a sum is a function of the sheets (`sum[a·sheets + b]`).
+    pub(super) fn sheet_group(&self) -> (Vec<S::Elem>, Vec<usize>) {
+        let sheets = self.copies.len();
+        let mut by_sheet = vec![self.space.identity(); sheets];
+        for &t in &self.copies {
+            by_sheet[self.space.sheet_of(t, self.level)] = t;
+        }
+        let sum = (0..sheets * sheets)
+            .map(|k| {
+                let (a, b) = (by_sheet[k / sheets], by_sheet[k % sheets]);
+                self.space.sheet_of(self.space.compose(a, b), self.level)
+            })
+            .collect();
+        (by_sheet, sum)
     }
 
     /// Drops the points whose vertices were removed (`gone`) and renumbers the rest in

@@ -9,11 +9,16 @@ use std::borrow::Cow;
 
 use super::covering::{drop_gone, renumbering, single_edges};
 use super::insert::Refused;
-use super::wrap::{Owner, Wrapped};
+use super::wrap::{facet_key, Owner, Wrapped};
 use super::{Candidate, Engine, LiftedCell};
 use crate::ids::{CellId, PointId, VertexId};
 use crate::predicates::Sign;
 use crate::space::OrbitSpace;
+use rustc_hash::FxHashMap;
+
+/// The cells that fill a hole, as gift wrapping gives them.
+type Filling<S, const N: usize> =
+    Vec<Wrapped<<S as OrbitSpace<N>>::Point, <S as OrbitSpace<N>>::Elem, N>>;
 
 /// How a point left the triangulation.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -185,7 +190,82 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     fn remove_copies(&mut self, p: PointId) -> bool {
         // (the quotient has one sheet: its vertex is the point's id)
         let sheets = self.space.sheets(self.level) as u32;
+        if sheets > 1 && self.space.translations_only() {
+            if let Some(done) = self.remove_congruent_copies(p) {
+                return done;
+            }
+        }
         (0..sheets).all(|s| self.remove_vertex(VertexId(p.0 * sheets + s)).is_ok())
+    }
+
+    /// In a covering whose sheets are translations, the triangulation is invariant under
+    /// the group of its sheets, so the copies of `p` have congruent stars and their holes
+    /// congruent Delaunay triangulations (the perturbation is the same for every copy).
+    /// When no copy of `p` is in the star of another (then removing one leaves the others'
+    /// stars as they were), the hole of the first is wrapped once and its cells are moved
+    /// to each other copy's hole: a covering of level 0 wraps one hole instead of 27.
+    /// `None` when copies are neighbours (the caller removes them one by one).
+    fn remove_congruent_copies(&mut self, p: PointId) -> Option<bool> {
+        let sheets = self.space.sheets(self.level);
+        let first = VertexId::new(p.index() * sheets);
+        let star = self.star(first);
+        let neighbours = star.iter().any(|&(c, _, _)| {
+            let cell = self.tds.cells[c.index()];
+            cell.v
+                .iter()
+                .any(|&u| u != first && self.vpoint[u.index()] == p)
+        });
+        if neighbours {
+            return None;
+        }
+        let Ok(cells) = self.hole_cells(&star, false) else {
+            return Some(false);
+        };
+        let (by_sheet, sum) = self.sheet_group();
+        self.replace_star(first, &star, &cells);
+        let home = first.index() % sheets;
+        for (g, &t) in by_sheet.iter().enumerate() {
+            let moved = |u: VertexId| {
+                let (q, a) = (u.index() / sheets, u.index() % sheets);
+                VertexId::new(q * sheets + sum[g * sheets + a])
+            };
+            let copy = moved(first);
+            if copy.index() % sheets == home {
+                continue;
+            }
+            let star = self.star(copy);
+            // the facets of the copy's hole, by their vertices: who is across each
+            let mut across: FxHashMap<[VertexId; N], (CellId, usize)> = FxHashMap::default();
+            for &(c, i, _) in &star {
+                let cell = self.tds.cells[c.index()];
+                let d = cell.n[i];
+                across.insert(facet_key(&cell.v, i), (d, self.mirror_of(d, c)));
+            }
+            let mut ok = true;
+            let copied: Filling<S, N> = cells
+                .iter()
+                .map(|w| {
+                    let vids = w.vids.map(moved);
+                    let mut links = w.links;
+                    for (m, link) in links.iter_mut().enumerate() {
+                        if let Some(Owner::Old(..)) = link {
+                            let old = across.get(&facet_key(&vids, m)).copied();
+                            ok &= old.is_some();
+                            *link = old.map(|(d, j)| Owner::Old(d, j));
+                        }
+                    }
+                    let arr = w.arr.map(|(x, o)| (x, self.space.compose(t, o)));
+                    Wrapped { vids, arr, links }
+                })
+                .collect();
+            debug_assert!(ok, "the copies' stars are congruent");
+            if ok {
+                self.replace_star(copy, &star, &copied);
+            } else if self.remove_vertex(copy).is_err() {
+                return Some(false);
+            }
+        }
+        Some(true)
     }
 
     /// After the vertices of point `p` were removed: the last point moves into its slot,
@@ -311,13 +391,26 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// cells break the switch criterion.
     fn remove_vertex_keeping(&mut self, v: VertexId, criterion: bool) -> Result<(), RemoveError> {
         let star = self.star(v);
+        let cells = self.hole_cells(&star, criterion)?;
+        self.replace_star(v, &star, &cells);
+        Ok(())
+    }
+
+    /// The Delaunay triangulation of the hole that removing the vertex whose star is `star`
+    /// leaves, found by gift wrapping, when the space allows it (see
+    /// [`Self::remove_vertex_keeping`]; the cells are not changed).
+    fn hole_cells(
+        &mut self,
+        star: &[(CellId, usize, S::Elem)],
+        criterion: bool,
+    ) -> Result<Filling<S, N>, RemoveError> {
         let shifted = |e: &Self, c: CellId, shift: S::Elem| -> LiftedCell<S, N> {
             e.lifted_cell(c)
                 .map(|(p, o)| (p, e.space.compose(shift, o)))
         };
         let mut hole: Vec<Candidate<S, N>> = Vec::new();
         let mut seeds = Vec::with_capacity(star.len());
-        for &(c, i, shift) in &star {
+        for &(c, i, shift) in star {
             let mut arr = shifted(self, c, shift);
             let cell = self.tds.cells[c.index()];
             for k in (0..N).filter(|&k| k != i) {
@@ -366,16 +459,25 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             }
             self.set_guaranteed(false);
         }
-        for &(c, _, _) in &star {
+        Ok(cells)
+    }
+
+    /// Replaces the star of `v` by the cells of its hole.
+    fn replace_star(
+        &mut self,
+        v: VertexId,
+        star: &[(CellId, usize, S::Elem)],
+        cells: &[Wrapped<S::Point, S::Elem, N>],
+    ) {
+        for &(c, _, _) in star {
             self.kill_cell(c);
         }
-        self.commit(&cells);
+        self.commit(cells);
         self.vcell[v.index()] = CellId::NONE;
         // (in a covering, the criterion's count goes on: `descend` uses it)
         if self.one_sheeted && !self.guaranteed && self.big_count == 0 {
             self.set_guaranteed(true);
         }
-        Ok(())
     }
 
     /// True when replacing the cells `star` (sorted) by `cells` leaves no cycle of length
@@ -432,6 +534,7 @@ mod tests {
     use std::collections::BTreeSet;
 
     use crate::delaunay::{from_dummies, uniform_cube, Engine};
+    use crate::ids::{PointId, VertexId};
     use crate::space::{FlatTorus3, OrbitSpace};
 
     /// Every cell as its points' coordinates (bits) and offsets, sorted, the first offset
@@ -483,6 +586,45 @@ mod tests {
             }
             assert!(geometry(&e) == geometry(&fresh), "{name}");
         }
+    }
+
+    /// In a covering, the copies of a point leave as one hole wrapped and moved to the
+    /// others: the same cells as removing each copy's vertex in turn. A point whose copies
+    /// are neighbours is left to that way, unchanged.
+    #[test]
+    fn copies_leave_a_covering_as_congruent_holes() {
+        let (mut moved, mut declined) = (0, 0);
+        for (n, seed) in [(3, 1), (5, 2), (24, 3), (40, 4)] {
+            for p in [0, n / 2, n - 1].map(PointId::new) {
+                let (mut a, mut b) = (uniform_cube(n, seed), uniform_cube(n, seed));
+                let sheets = a.space.sheets(a.level);
+                assert!(sheets > 1, "{n} points stay in a covering");
+                let before = geometry(&a);
+                match a.remove_congruent_copies(p) {
+                    None => {
+                        declined += 1;
+                        assert!(geometry(&a) == before, "{n} points, point {p:?}");
+                    }
+                    Some(done) => {
+                        moved += 1;
+                        let one_by_one = (0..sheets).all(|s| {
+                            b.remove_vertex(VertexId::new(p.index() * sheets + s))
+                                .is_ok()
+                        });
+                        assert_eq!(done, one_by_one, "{n} points, point {p:?}");
+                        a.renumber_last_point(p);
+                        b.renumber_last_point(p);
+                        a.is_valid().unwrap();
+                        assert!(geometry(&a) == geometry(&b), "{n} points, point {p:?}");
+                        assert!(geometry(&a) != before, "{n} points, point {p:?}");
+                    }
+                }
+            }
+        }
+        assert!(
+            moved > 0 && declined > 0,
+            "{moved} moved, {declined} declined"
+        );
     }
 
     /// The first `k` points leave and the last take their ids, the others keep theirs; the

@@ -32,6 +32,13 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 if (i + 1..N).any(|j| cell.v[i] == cell.v[j]) {
                     return bad(format!("cell {c} repeats vertex {}", cell.v[i]));
                 }
+                // (in a covering, a vertex is the copy of its point in its offset's sheet)
+                if cell.v[i] != self.vertex_id(self.vpoint[cell.v[i].index()], cell.off[i]) {
+                    return bad(format!(
+                        "cell {c}: vertex {} is not in its sheet",
+                        cell.v[i]
+                    ));
+                }
                 let d = cell.n[i];
                 if d == CellId::NONE || !self.tds.is_alive(d) {
                     return bad(format!("cell {c} has no neighbour {i}"));
