@@ -9,6 +9,8 @@
 #           each dummy point sits alone in the empty tube between four lines;
 #   shell:  N points in a hollow spherical shell (radius 0.3 to 0.31 about the centre),
 #           where the dummy points inside have every point of the shell in their link;
+#   blob:   N points of a Gaussian blob (sigma 0.05 about the centre) in a vacuum, a
+#           molecule or cluster in a large periodic box (the build ends in the covering);
 #   sc, bcc, fcc: the simple, body-centred and face-centred cubic crystals filling the
 #           unit cube with about N atoms (k³, 2k³, 4k³ for the k nearest), where every
 #           Delaunay sphere passes through 8 (sc), 4 (bcc) or 6 (fcc) atoms and most
@@ -19,7 +21,7 @@
 #
 # usage: bench/degenerate.sh [REPS] [N ...]      default: 3 reps, N = 20000 50000 200000
 #        INPUTS="planes slab" (default) chooses the inputs, e.g. INPUTS="sc bcc fcc" or
-#        INPUTS="lines shell".
+#        INPUTS="lines shell blob".
 set -euo pipefail
 . "$(dirname "$0")/setup.sh"
 anchor_src=${ANCHOR:-$root/../shared/anchors/cgal}
@@ -50,6 +52,8 @@ with open(path, "w") as f:
     for i in range(0 if input in basis else n):
         if input == "lines":
             p = (rng.random(), 0.25 * (i % 4) + 0.1, 0.25 * (i // 4 % 4) + 0.1)
+        elif input == "blob":
+            p = tuple(0.5 + 0.05 * rng.gauss(0, 1) for _ in range(3))
         elif input == "shell":
             v = [rng.gauss(0, 1) for _ in range(3)]
             r = sum(c * c for c in v) ** 0.5

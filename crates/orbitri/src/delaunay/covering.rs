@@ -249,7 +249,6 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         let old = std::mem::take(&mut self.tds);
         let old_vpoint = std::mem::take(&mut self.vpoint);
         // the new cells are created in the order of `reps`: the `k`-th has id `k`
-        let mut reps: Vec<CellId> = Vec::new();
         let mut orbit = vec![CellId::NONE; old.cells.len()];
         // Into the quotient of a torus, the group of the sheets moves each cell onto one
         // cell for each sheet of its vertex of least point (two copies of a point share no
@@ -276,33 +275,42 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             k
         };
         let mut named: FxHashMap<[u32; N], CellId> = FxHashMap::default();
-        let mut index: FxHashMap<[(PointId, S::Elem); N], CellId> = FxHashMap::default();
-        for c in old.ids() {
-            let k = CellId::new(reps.len());
-            if free {
-                if least(&old.cells[c.index()].v).0 % sheets == 0 {
-                    let fresh = named.insert(class(c), k).is_none();
-                    debug_assert!(
-                        fresh,
-                        "one cell of an orbit has its least vertex in sheet 0"
-                    );
-                    orbit[c.index()] = k;
-                    reps.push(c);
-                }
-            } else {
+        let reps: Vec<CellId> = if free {
+            // (found and named on the threads, in the order of their ids)
+            let reps: Vec<CellId> = (0..old.cells.len() as u32)
+                .into_par_iter()
+                .map(CellId)
+                .filter(|&c| old.is_alive(c) && least(&old.cells[c.index()].v).0 % sheets == 0)
+                .collect();
+            let names: Vec<[u32; N]> = reps.par_iter().map(|&c| class(c)).collect();
+            named.reserve(reps.len());
+            for (k, (&c, name)) in reps.iter().zip(names).enumerate() {
+                let fresh = named.insert(name, CellId::new(k)).is_none();
+                debug_assert!(
+                    fresh,
+                    "one cell of an orbit has its least vertex in sheet 0"
+                );
+                orbit[c.index()] = CellId::new(k);
+            }
+            reps
+        } else {
+            let mut reps = Vec::new();
+            let mut index: FxHashMap<[(PointId, S::Elem); N], CellId> = FxHashMap::default();
+            for c in old.ids() {
                 let key = quotient_key(&self.space, &old_vpoint, &old.cell(c), level);
                 orbit[c.index()] = *index.entry(key).or_insert_with(|| {
                     reps.push(c);
-                    k
+                    CellId::new(reps.len() - 1)
                 });
             }
-        }
+            reps
+        };
         let orbit_of = |d: CellId| match orbit[d.index()] {
             CellId::NONE => named[&class(d)],
             k => k,
         };
         let cells: Vec<Cell<S::Elem, N>> = reps
-            .iter()
+            .par_iter()
             .map(|&c| {
                 let was = old.cell(c);
                 let mut cell = Cell::new(was.v, was.off);
@@ -342,9 +350,12 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         // each cell's criterion for the level after 0 (its copies are congruent), each
         // facet's neighbour and the sheet of the element from its frame to the cell's
         let limit = self.space.criterion_radius2(1.min(self.last_level()));
-        let big: Vec<bool> = ids.iter().map(|&c| self.cell_radius2(c) >= limit).collect();
+        let big: Vec<bool> = ids
+            .par_iter()
+            .map(|&c| self.cell_radius2(c) >= limit)
+            .collect();
         let across: Vec<[(u32, usize); N]> = ids
-            .iter()
+            .par_iter()
             .map(|&c| {
                 std::array::from_fn(|i| {
                     let d = self.tds.cells[c.index()].n[i];
@@ -353,35 +364,57 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 })
             })
             .collect();
+        // and the sheet of each vertex's element
+        let at: Vec<[u32; N]> = ids
+            .par_iter()
+            .map(|&c| self.tds.off(c).map(|o| self.space.sheet_of(o, 0) as u32))
+            .collect();
         let old = std::mem::take(&mut self.tds);
+        let home = std::mem::take(&mut self.vcell);
         self.enter_level(0);
         let sheets = self.copies.len();
         let (by_sheet, sum) = self.sheet_group();
-        self.tds.reserve(ids.len() * sheets);
-        for (a, &c) in ids.iter().enumerate() {
-            let was = old.cell(c);
-            let at = was.off.map(|o| self.space.sheet_of(o, 0));
-            for (s, &t) in by_sheet.iter().enumerate() {
-                let mut cell = Cell::new(was.v, was.off.map(|o| self.space.compose(t, o)));
-                cell.n = std::array::from_fn(|i| {
-                    let (b, g) = across[a][i];
-                    CellId::new(b as usize * sheets + sum[s * sheets + g])
-                });
-                cell.v = std::array::from_fn(|i| {
-                    VertexId::new(was.v[i].index() * sheets + sum[s * sheets + at[i]])
-                });
-                // (a shift by the group of level 0 keeps every sheet)
-                self.canonicalize(&mut cell);
-                debug_assert!((0..N)
-                    .all(|i| { cell.v[i] == self.vertex_id(PointId(was.v[i].0), cell.off[i]) }));
-                let id = self.tds.create(cell);
-                debug_assert_eq!(id.index(), a * sheets + s);
-            }
+        let mut tds = std::mem::take(&mut self.tds);
+        // the copy of cell `a` by sheet `s` has id `a·sheets + s`
+        let copy = |k: usize| {
+            let (a, s) = (k / sheets, k % sheets);
+            let was = old.cell(ids[a]);
+            let mut cell = Cell::new(was.v, was.off.map(|o| self.space.compose(by_sheet[s], o)));
+            cell.n = std::array::from_fn(|i| {
+                let (b, g) = across[a][i];
+                CellId::new(b as usize * sheets + sum[s * sheets + g])
+            });
+            cell.v = std::array::from_fn(|i| {
+                VertexId::new(was.v[i].index() * sheets + sum[s * sheets + at[a][i] as usize])
+            });
+            // (a shift by the group of level 0 keeps every sheet)
+            self.canonicalize(&mut cell);
+            debug_assert!(
+                (0..N).all(|i| { cell.v[i] == self.vertex_id(PointId(was.v[i].0), cell.off[i]) })
+            );
+            cell
+        };
+        tds.extend_with(ids.len() * sheets, copy);
+        // the copy of vertex `p` in sheet `t` is in the copy of `p`'s cell by the sheet
+        // that takes `p`'s own sheet there
+        let mut by = vec![0; sheets * sheets];
+        for (k, &t) in sum.iter().enumerate() {
+            by[t * sheets + k % sheets] = k / sheets;
         }
-        let n = self.tds.cells.len();
-        for k in 0..n as u32 {
-            self.attach(CellId(k));
-        }
+        let vcell = (0..self.vpoint.len())
+            .into_par_iter()
+            .map(|v| {
+                let (p, t) = (v / sheets, v % sheets);
+                let c = home[p];
+                if c == CellId::NONE {
+                    return c;
+                }
+                let i = old.cells[c.index()].index_of(VertexId::new(p));
+                let at = self.space.sheet_of(old.off_at(c, i.unwrap_or(0)), 0);
+                CellId::new(dense[c.index()] as usize * sheets + by[t * sheets + at])
+            })
+            .collect();
+        (self.tds, self.vcell) = (tds, vcell);
         self.guaranteed = false;
         self.big = big
             .iter()

@@ -422,6 +422,45 @@ impl<O: Packing, const N: usize> Tds<O, N> {
         unsafe { self.cells.set_len(self.cells.len() + more) };
     }
 
+    /// Appends `len` cells, the one of id `k` made by `make(k)` on rayon's threads (a
+    /// covering's lift writes tens of millions at once). `make` is called again for every
+    /// new cell if one of them turns the store wide.
+    pub fn extend_with<F>(&mut self, len: usize, make: F)
+    where
+        O: Send + Sync,
+        F: Fn(usize) -> Cell<O, N> + Sync,
+    {
+        const BLOCK: usize = 1 << 14;
+        let start = self.cells.len();
+        let fits = std::sync::atomic::AtomicBool::new(true);
+        self.cells.reserve(len);
+        self.cells.spare_capacity_mut()[..len]
+            .par_chunks_mut(BLOCK)
+            .enumerate()
+            .for_each(|(b, slots)| {
+                for (k, slot) in slots.iter_mut().enumerate() {
+                    let c = make(start + b * BLOCK + k);
+                    let stored = Stored::pack(&c).unwrap_or_else(|| {
+                        fits.store(false, std::sync::atomic::Ordering::Relaxed);
+                        Stored {
+                            v: c.v,
+                            n: c.n,
+                            slots: [O::Slot::default(); N],
+                            stamp: 0,
+                        }
+                    });
+                    slot.write(stored);
+                }
+            });
+        // SAFETY: the capacity holds `len` slots after the length, all written above
+        unsafe { self.cells.set_len(start + len) };
+        if !fits.into_inner() || !self.is_packed() {
+            let wide = self.widen();
+            wide.truncate(start);
+            wide.par_extend((start..start + len).into_par_iter().map(|k| make(k).off));
+        }
+    }
+
     /// Takes every free slot (the caller fills them or [`Self::delete`]s them again).
     pub fn take_free(&mut self) -> Vec<CellId> {
         std::mem::take(&mut self.free)
@@ -607,6 +646,44 @@ mod tests {
         assert!(tds.cells[1..].iter().all(|&c| c == dead));
         tds.grow(10, Stored::pack(&live).unwrap());
         assert_eq!(tds.cells.len(), 40_000);
+    }
+
+    /// Cells made on the threads land in order after the others, packed while they fit;
+    /// one that does not turns the store wide with every element kept, the old ones too.
+    #[test]
+    fn extending_on_the_threads_appends_the_cells_in_order() {
+        let cell = |k: usize| {
+            let v = [0, 1, 2, 3].map(|i| VertexId::new(4 * k + i));
+            let mut c = Cell::new(v, [[(k % 4) as i8, 0, 1], [0; 3], [1, 1, 1], [0; 3]]);
+            c.n = [
+                CellId::new(k + 1),
+                CellId::NONE,
+                CellId::new(k),
+                CellId::new(2),
+            ];
+            c
+        };
+        let mut tds: Tds<[i8; 3], 4> = Tds::new();
+        let first = tds.create(cell(0));
+        // more cells than one of the threads' pieces
+        tds.extend_with(40_000, cell);
+        assert!(tds.is_packed());
+        assert_eq!(tds.cells.len(), 40_001);
+        assert_eq!(tds.cell(first), cell(0));
+        assert!((0..40_001).all(|k| tds.cell(CellId::new(k)) == cell(k)));
+        // a far offset among them: wide, each cell as made
+        let far = |k: usize| {
+            let mut c = cell(k);
+            c.off[1] = [(k % 9) as i8, 0, 5];
+            c
+        };
+        tds.extend_with(20_000, far);
+        assert!(!tds.is_packed());
+        assert!((0..40_001).all(|k| tds.cell(CellId::new(k)) == cell(k)));
+        assert!((40_001..60_001).all(|k| tds.cell(CellId::new(k)) == far(k)));
+        tds.extend_with(3, cell);
+        assert_eq!(tds.cell(CellId::new(60_003)), cell(60_003));
+        assert_eq!(tds.cell(CellId::new(60_000)), far(60_000));
     }
 
     #[test]
