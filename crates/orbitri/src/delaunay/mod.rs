@@ -584,19 +584,40 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     }
 
     /// Gives point `p` the representative `coords`, where `coords + t·M` is its current
-    /// position: every copy's star gets its offset shifted by `t`, so no cell moves.
+    /// position: every copy's star gets its offset shifted by `t`, so no cell moves. In a
+    /// covering each copy is renamed for the sheet of its new offset (an element outside
+    /// the level's group moves the copies between sheets).
     pub(crate) fn move_representative(&mut self, p: PointId, coords: S::Point, t: S::Elem) {
         // the point itself once 1-sheeted; its copies `p·S … p·S+S−1` in the covering
         let copies = self.space.sheets(self.level) as u32;
+        let mut slots: Vec<(CellId, usize)> = Vec::new();
+        let mut homes: Vec<(VertexId, CellId)> = Vec::new();
         for v in p.0 * copies..(p.0 + 1) * copies {
             let v = VertexId(v);
             debug_assert_eq!(self.vpoint[v.index()], p);
-            for (c, k, _) in self.star(v) {
-                let mut cell = self.tds.cell(c);
-                cell.off[k] = self.space.compose(cell.off[k], t);
-                self.canonicalize(&mut cell);
-                self.tds.put(c, cell);
+            let c = self.vcell[v.index()];
+            if c == CellId::NONE {
+                continue;
             }
+            let k = self.tds.cells[c.index()].index_of(v).unwrap_or(0);
+            let moved = self.space.compose(self.tds.off_at(c, k), t);
+            homes.push((self.vertex_id(p, moved), c));
+            slots.extend(self.star(v).iter().map(|&(c, k, _)| (c, k)));
+        }
+        // (a cell with two copies changes once)
+        slots.sort_unstable();
+        for cell_slots in slots.chunk_by(|a, b| a.0 == b.0) {
+            let c = cell_slots[0].0;
+            let mut cell = self.tds.cell(c);
+            for &(_, k) in cell_slots {
+                cell.off[k] = self.space.compose(cell.off[k], t);
+                cell.v[k] = self.vertex_id(p, cell.off[k]);
+            }
+            self.canonicalize(&mut cell);
+            self.tds.put(c, cell);
+        }
+        for (v, c) in homes {
+            self.vcell[v.index()] = c;
         }
         self.points[p.index()] = coords;
     }

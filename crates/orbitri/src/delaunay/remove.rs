@@ -222,6 +222,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             return Some(false);
         };
         let (by_sheet, sum) = self.sheet_group();
+        let first_star = star.len();
         self.replace_star(first, &star, &cells);
         let home = first.index() % sheets;
         for (g, &t) in by_sheet.iter().enumerate() {
@@ -241,7 +242,8 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 let d = cell.n[i];
                 across.insert(facet_key(&cell.v, i), (d, self.mirror_of(d, c)));
             }
-            let mut ok = true;
+            // (congruent stars: as many cells, each outer facet found below)
+            let mut ok = star.len() == first_star;
             let copied: Filling<S, N> = cells
                 .iter()
                 .map(|w| {
