@@ -262,14 +262,12 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         } else {
             Vec::new()
         };
-        let to_first: Vec<u32> = (0..sum.len().isqrt())
-            .map(|a| (0..sheets as usize).position(|b| sum[b * sheets as usize + a] == 0))
-            .map(|b| b.unwrap_or(0) as u32)
-            .collect();
+        // (`to[a]`: the sheet whose translation takes sheet `a` to sheet 0)
+        let to = taking(&sum, sheets as usize);
         let least = |v: &[VertexId; N]| v[(0..N).min_by_key(|&i| v[i].0 / sheets).unwrap_or(0)];
         let class = |c: CellId| {
             let v = old.cells[c.index()].v;
-            let g = to_first[(least(&v).0 % sheets) as usize] * sheets;
+            let g = to[(least(&v).0 % sheets) as usize] as u32 * sheets;
             let mut k = v.map(|u| u.0 - u.0 % sheets + sum[(g + u.0 % sheets) as usize] as u32);
             k.sort_unstable();
             k
@@ -397,10 +395,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         tds.extend_with(ids.len() * sheets, copy);
         // the copy of vertex `p` in sheet `t` is in the copy of `p`'s cell by the sheet
         // that takes `p`'s own sheet there
-        let mut by = vec![0; sheets * sheets];
-        for (k, &t) in sum.iter().enumerate() {
-            by[t * sheets + k % sheets] = k / sheets;
-        }
+        let to = taking(&sum, sheets);
         let vcell = (0..self.vpoint.len())
             .into_par_iter()
             .map(|v| {
@@ -409,9 +404,9 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 if c == CellId::NONE {
                     return c;
                 }
-                let i = old.cells[c.index()].index_of(VertexId::new(p));
-                let at = self.space.sheet_of(old.off_at(c, i.unwrap_or(0)), 0);
-                CellId::new(dense[c.index()] as usize * sheets + by[t * sheets + at])
+                let a = dense[c.index()] as usize;
+                let i = old.cells[c.index()].index_of(VertexId::new(p)).unwrap_or(0);
+                CellId::new(a * sheets + to[t * sheets + at[a][i] as usize])
             })
             .collect();
         (self.tds, self.vcell) = (tds, vcell);
@@ -493,6 +488,16 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         }
         self.one_sheeted
     }
+}
+
+/// For a table of sheet sums (`sum[a·sheets + b]`, see `Engine::sheet_group`), the
+/// sheet whose translation takes sheet `a` to sheet `t`, at `t·sheets + a`.
+fn taking(sum: &[usize], sheets: usize) -> Vec<usize> {
+    let mut to = vec![0; sum.len()];
+    for (k, &t) in sum.iter().enumerate() {
+        to[t * sheets + k % sheets] = k / sheets;
+    }
+    to
 }
 
 /// True when the edges `(neighbour, relative element)` at `own` never reach `own` and reach
