@@ -156,7 +156,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     pub(super) fn descend(&mut self) {
         while !self.one_sheeted && self.big_count == 0 {
             // (the new cells are tracked against the criterion of the level after)
-            self.convert(self.level + 1);
+            self.convert((self.level + 1).min(self.last_level()));
         }
         if self.one_sheeted && self.big_count == 0 {
             self.set_guaranteed(true);
@@ -240,10 +240,11 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     }
 
     /// Replaces the covering triangulation by its projection to the space of a later
-    /// `level`: one cell per orbit of cells under that space's group, vertex ids renumbered
+    /// `level` (from the lift level, the quotient): one cell per orbit of cells under that space's group, vertex ids renumbered
     /// for its sheets. The caller guarantees the projection is simplicial.
     pub(crate) fn convert(&mut self, level: usize) {
-        if level <= self.level {
+        // (from the lift level, after the ladder's, to the quotient)
+        if level <= self.level && self.level <= self.last_level() {
             return;
         }
         let old = std::mem::take(&mut self.tds);
@@ -331,23 +332,27 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         self.hint = CellId(0);
     }
 
-    /// Replaces the 1-sheeted triangulation of a torus by its lift to the covering of level
-    /// 0, each cell once per sheet: where every point set has a triangulation, so that the
-    /// points whose removal would break the quotient can go (thesis §2.3.1: the dummy points
-    /// left are removed after a conversion to the 27-sheeted covering, not by triangulating
-    /// every point again). The copy of a cell by `t` meets, across each facet, the copy of
-    /// that neighbour by `t` composed with the element between their frames; a copy is
-    /// large for the next level's criterion when its cell is.
-    pub(crate) fn unfold(&mut self) {
+    /// Replaces the 1-sheeted triangulation of a torus by its lift to the covering of
+    /// `level`, each cell once per sheet: level 0, where every point set has a
+    /// triangulation, so that the points whose removal would break the quotient can go
+    /// (thesis §2.3.1: the dummy points left are removed after a conversion to the
+    /// 27-sheeted covering, not by triangulating every point again), or the space's lift
+    /// level ([`OrbitSpace::lift_level`]), where they can while its criterion holds. The
+    /// copy of a cell by `t` meets, across each facet, the copy of that neighbour by `t`
+    /// composed with the element between their frames; a copy is large for the next
+    /// level's criterion when its cell is.
+    pub(crate) fn unfold(&mut self, level: usize) {
         debug_assert!(self.one_sheeted && self.space.translations_only());
         let ids: Vec<CellId> = self.tds.ids().collect();
         let mut dense = vec![u32::MAX; self.tds.cells.len()];
         for (k, c) in ids.iter().enumerate() {
             dense[c.index()] = k as u32;
         }
-        // each cell's criterion for the level after 0 (its copies are congruent), each
-        // facet's neighbour and the sheet of the element from its frame to the cell's
-        let limit = self.space.criterion_radius2(1.min(self.last_level()));
+        // each cell's criterion for the level after (its copies are congruent), each facet's
+        // neighbour and the sheet of the element from its frame to the cell's
+        let limit = self
+            .space
+            .criterion_radius2((level + 1).min(self.last_level()));
         let big: Vec<bool> = ids
             .par_iter()
             .map(|&c| self.cell_radius2(c) >= limit)
@@ -358,18 +363,22 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 std::array::from_fn(|i| {
                     let d = self.tds.cells[c.index()].n[i];
                     let g = self.translation(c, i, d);
-                    (dense[d.index()], self.space.sheet_of(g, 0))
+                    (dense[d.index()], self.space.sheet_of(g, level))
                 })
             })
             .collect();
         // and the sheet of each vertex's element
         let at: Vec<[u32; N]> = ids
             .par_iter()
-            .map(|&c| self.tds.off(c).map(|o| self.space.sheet_of(o, 0) as u32))
+            .map(|&c| {
+                self.tds
+                    .off(c)
+                    .map(|o| self.space.sheet_of(o, level) as u32)
+            })
             .collect();
         let old = std::mem::take(&mut self.tds);
         let home = std::mem::take(&mut self.vcell);
-        self.enter_level(0);
+        self.enter_level(level);
         let sheets = self.copies.len();
         let (by_sheet, sum) = self.sheet_group();
         let mut tds = std::mem::take(&mut self.tds);
@@ -385,7 +394,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             cell.v = std::array::from_fn(|i| {
                 VertexId::new(was.v[i].index() * sheets + sum[s * sheets + at[a][i] as usize])
             });
-            // (a shift by the group of level 0 keeps every sheet)
+            // (a shift by the group of the level keeps every sheet)
             self.canonicalize(&mut cell);
             debug_assert!(
                 (0..N).all(|i| { cell.v[i] == self.vertex_id(PointId(was.v[i].0), cell.off[i]) })

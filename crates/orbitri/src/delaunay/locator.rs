@@ -20,7 +20,7 @@ use crate::space::OrbitSpace;
 const NEAR: usize = 1;
 
 /// The grid: `slots[key >> shift]` is a vertex whose point had that key prefix.
-#[derive(Debug, Default)]
+#[derive(Clone, Debug, Default)]
 pub(super) struct Locator {
     shift: u32,
     slots: Vec<VertexId>,

@@ -41,7 +41,7 @@ pub type Candidate<S, const N: usize> = (VertexId, LiftedOf<S, N>);
 const STAR_SCANNED: usize = 256;
 
 /// Reusable buffers of one insertion or removal (no allocation per point).
-#[derive(Debug)]
+#[derive(Clone, Debug)]
 struct Scratch<O> {
     /// Conflict cells with the query's offset in each cell's frame.
     conflict: Vec<(CellId, O)>,
@@ -102,7 +102,7 @@ pub struct HiddenPoint<P> {
 }
 
 /// A Delaunay triangulation of an orbit space.
-#[derive(Debug)]
+#[derive(Clone, Debug)]
 pub struct Engine<S: OrbitSpace<N>, const N: usize> {
     pub(crate) space: S,
     /// The distinct points (dummy points, while present, at the end).
@@ -399,7 +399,9 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         }
     }
 
-    /// The level of the covering ladder the triangulation lives in (the last is the quotient).
+    /// The level of the covering ladder the triangulation lives in (the last is the
+    /// quotient), or the space's lift level ([`OrbitSpace::lift_level`], numbered after
+    /// the ladder's).
     pub fn level(&self) -> usize {
         self.level
     }

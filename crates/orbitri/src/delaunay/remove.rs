@@ -14,6 +14,7 @@ use super::{Candidate, Engine, LiftedCell};
 use crate::ids::{CellId, PointId, VertexId};
 use crate::predicates::Sign;
 use crate::space::OrbitSpace;
+use rayon::prelude::*;
 use rustc_hash::FxHashMap;
 
 /// The cells that fill a hole, as gift wrapping gives them.
@@ -111,8 +112,10 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     }
 
     /// Removes points `0..k` (a bulk build's dummy points), largest id first, those refused
-    /// again after the others; when a round removes none, a torus goes on in the covering
-    /// of level 0 ([`Self::unfold`]), where every removal goes in place. Then the last point
+    /// again after the others; when a round removes none, a torus goes on in a covering
+    /// ([`Self::unfold`]): that of its lift level when the points look able to leave there
+    /// ([`Self::lift_may_do`]), else, or when one cannot after all, that of level 0 (from
+    /// the quotient as it was), where every removal goes in place. Then the last point
     /// takes each one's id, largest first: the other points keep theirs, so only the cells
     /// around the `k` moved points are rewritten, where renumbering all in order
     /// ([`Self::compact`]) rewrites every cell. Returns, for each id `d < k`, the first id
@@ -125,27 +128,49 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         // whose dummy points link across it) may go once others have; those that left
         // early (`Self::dummies_leave`) are gone
         let mut left: Vec<usize> = (0..k).rev().filter(|&d| self.has_vertex(d)).collect();
+        // the quotient and the points left as they were when lifted to the space's lift
+        // level: if one cannot leave there either, level 0 takes them from it
+        let mut before_lift: Option<(Box<Self>, Vec<usize>)> = None;
+        let mut lifted = false;
         while !left.is_empty() {
             let before = left.len();
             let mut refused = Vec::new();
+            // (a refusal at the lift level changes nothing, unless the copies' stars were
+            // not congruent: then some copies are gone, and level 0 takes over)
+            let mut half_done = false;
             for &d in &left {
                 if !self.remove_copies(PointId::new(d)) {
-                    if !self.one_sheeted {
+                    if !self.one_sheeted && !self.at_lift_level() {
                         // (some of its copies may be gone)
                         return None;
                     }
+                    half_done |= !self.has_vertex(d);
                     refused.push(d);
                 }
             }
             left = refused;
-            if left.len() == before {
+            if left.len() == before || half_done {
                 if !self.space.translations_only() {
                     return None;
                 }
-                // (in the covering of level 0 every removal goes in place)
-                self.unfold();
+                match self.space.lift_level() {
+                    Some(lift) if !lifted && self.lift_may_do(&left, k, lift) => {
+                        lifted = true;
+                        before_lift = Some((Box::new(self.clone()), left.clone()));
+                        self.unfold(lift);
+                    }
+                    _ => {
+                        if let Some((quotient, was_left)) = before_lift.take() {
+                            (*self, left) = (*quotient, was_left);
+                        }
+                        lifted = true;
+                        // (in the covering of level 0 every removal goes in place)
+                        self.unfold(0);
+                    }
+                }
             }
         }
+        drop(before_lift);
         // down the ladder as far as the criterion allows (the quotient is tried after)
         self.descend();
         let mut moved = vec![PointId::NONE; k];
@@ -176,6 +201,77 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         gone
     }
 
+    /// True in the covering of the space's lift level ([`OrbitSpace::lift_level`]).
+    fn at_lift_level(&self) -> bool {
+        self.level > self.last_level()
+    }
+
+    /// Whether the points `left` of the quotient (dummy points, ids below `k`) look able
+    /// to leave in the covering of `lift`. First, every cell must keep that level's
+    /// criterion (radius below `r`), so that its covering is triangulated for the points
+    /// and every superset: true when the quotient's holds, checked otherwise (removals in
+    /// the quotient may have left larger cells). Then the other points (ids `k` and more)
+    /// must leave no empty ball of radius `r`. With the quotient's criterion, the centre of
+    /// such a ball is in the Voronoi region of a point of `left` (it is further than the
+    /// quotient's radius from every other point), within the largest circumradius of its
+    /// star; so those balls are sampled on a grid of step `r/10`, each sample against the
+    /// other points among the dummy's neighbours and among the neighbours of its dummy
+    /// neighbours. A sample further than `r` from them says no. (An estimate: a nearer
+    /// point may lie further out, and a ball may slip between samples; a wrong guess costs
+    /// time, not the result, as what cannot leave there leaves from level 0.)
+    fn lift_may_do(&self, left: &[usize], k: usize, lift: usize) -> bool {
+        let limit = self.space.criterion_radius2(lift);
+        if !self.guaranteed {
+            let ids: Vec<CellId> = self.tds.ids().collect();
+            if !ids.par_iter().all(|&c| self.cell_radius2(c) < limit) {
+                return false;
+            }
+        }
+        let step = limit.sqrt() / 10.0;
+        let position = |q: VertexId, o| {
+            let p = self.points[self.vpoint[q.index()].index()];
+            self.space.ball_position((p, o)).map(|(at, _)| at)
+        };
+        let dummy = |q: VertexId| self.vpoint[q.index()].index() < k;
+        let dist2 = |a: &[f64; 3], b: &[f64; 3]| (0..3).map(|c| (a[c] - b[c]).powi(2)).sum::<f64>();
+        left.iter().all(|&d| {
+            let v = self.vertex_of_point(PointId::new(d));
+            let Some(centre) = position(v, self.space.identity()) else {
+                return false;
+            };
+            // the other points near `d`, relative to it, nearest first
+            let mut near = Vec::new();
+            for (u, to_u) in self.neighbours(v) {
+                if !dummy(u) {
+                    near.extend(position(u, to_u));
+                    continue;
+                }
+                for (w, to_w) in self.neighbours(u) {
+                    if !dummy(w) {
+                        near.extend(position(w, self.space.compose(to_u, to_w)));
+                    }
+                }
+            }
+            near.sort_by(|a, b| dist2(a, &centre).total_cmp(&dist2(b, &centre)));
+            let star = self.star(v);
+            let reach2 = star
+                .iter()
+                .map(|&(c, _, _)| self.cell_radius2(c))
+                .fold(0.0, f64::max);
+            let n = (reach2.sqrt() / step).ceil().min(64.0) as i32;
+            let depth = if N == 4 { n } else { 0 };
+            (-n..=n).all(|a| {
+                (-n..=n).all(|b| {
+                    (-depth..=depth).all(|c| {
+                        let x = [a, b, c].map(|t| f64::from(t) * step);
+                        let x: [f64; 3] = std::array::from_fn(|i| centre[i] + x[i]);
+                        dist2(&x, &centre) > reach2 || near.iter().any(|q| dist2(q, &x) < limit)
+                    })
+                })
+            })
+        })
+    }
+
     /// True when point `d` of the 1-sheeted triangulation has a vertex (a dummy point that
     /// has not left).
     pub(crate) fn has_vertex(&self, d: usize) -> bool {
@@ -193,6 +289,10 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         if sheets > 1 && self.space.translations_only() {
             if let Some(done) = self.remove_congruent_copies(p) {
                 return done;
+            }
+            if self.at_lift_level() {
+                // (copies that are neighbours break the level's criterion: it does not hold)
+                return false;
             }
         }
         (0..sheets).all(|s| self.remove_vertex(VertexId(p.0 * sheets + s)).is_ok())
@@ -537,6 +637,7 @@ mod tests {
 
     use crate::delaunay::{from_dummies, uniform_cube, Engine};
     use crate::ids::{PointId, VertexId};
+    use crate::sort::SplitMix;
     use crate::space::{FlatTorus3, OrbitSpace};
 
     /// Every cell as its points' coordinates (bits) and offsets, sorted, the first offset
@@ -586,6 +687,56 @@ mod tests {
             for &p in &pts {
                 fresh.insert(p);
             }
+            assert!(geometry(&e) == geometry(&fresh), "{name}");
+        }
+    }
+
+    /// The dummy points a slab beside a vacuum keeps leave in the covering of 8 sheets
+    /// (twice the systole), where its criterion holds for the slab's points. A bar beside a
+    /// vacuum looks as if its dummies would too, but its vacuum is wider: one dummy point cannot
+    /// leave there, and the quotient as it was goes to level 0. A blob leaves a void so
+    /// wide that its dummies go to level 0 at once. Each time: the cells of the points
+    /// inserted one by one, valid on the way, and a quotient after when there is one.
+    #[test]
+    fn the_last_dummy_points_leave_in_the_lift_covering_when_its_criterion_allows() {
+        // (name, its width along x and thickness along z, whether it looks able to, whether
+        // it leaves there)
+        let cases = [
+            ("slab", 1.0, 0.1, true, true),
+            ("bar", 0.6, 0.1, true, false),
+            ("blob", 0.0, 0.0, false, false),
+        ];
+        for (name, wide, thick, looks, lifts) in cases {
+            let space = FlatTorus3::cuboid([1.0; 3]).unwrap();
+            let mut e = Engine::new(space.clone());
+            e.points = space.dummy_points();
+            let k = e.points.len();
+            e.bootstrap_one_sheeted();
+            let mut r = SplitMix::new(7);
+            let pts: Vec<[f64; 3]> = (0..3000)
+                .map(|_| match name {
+                    "blob" => [0.5; 3].map(|c| c + 0.002 * r.unit()),
+                    _ => [wide * r.unit(), r.unit(), thick * r.unit()],
+                })
+                .collect();
+            for &p in &pts {
+                e.insert(p);
+            }
+            e.dummies_leave(k);
+            let lift = e.space.lift_level().expect("a 3D grid has a lift level");
+            let left: Vec<usize> = (0..k).filter(|&d| e.has_vertex(d)).collect();
+            assert!(!left.is_empty(), "{name}: dummies stay in the quotient");
+            assert_eq!(e.lift_may_do(&left, k, lift), looks, "{name}");
+            assert!(e.remove_first_points(k).is_some(), "{name}");
+            e.is_valid().unwrap();
+            assert_eq!(e.level, if lifts { lift } else { 0 }, "{name}");
+            let mut fresh = Engine::new(space.clone());
+            for &p in &pts {
+                fresh.insert(p);
+            }
+            assert_eq!(e.try_one_sheet(), fresh.try_one_sheet(), "{name}");
+            e.is_valid().unwrap();
+            assert_eq!(e.level, fresh.level, "{name}");
             assert!(geometry(&e) == geometry(&fresh), "{name}");
         }
     }

@@ -28,6 +28,9 @@ pub(super) type L<const D: usize> = Lifted<[f64; D], [i8; D]>;
 pub struct FlatTorus<const D: usize> {
     pub(super) lattice: Lattice<D>,
     ladder: Vec<Level<D>>,
+    /// At level `ladder.len()`: the covering a quotient is lifted to first
+    /// ([`Lattice::lift_level`]).
+    lift: Option<Level<D>>,
     kind: Ladder,
 }
 
@@ -78,6 +81,7 @@ impl<const D: usize> FlatTorus<D> {
     pub fn with_ladder(lattice: Lattice<D>, kind: Ladder) -> Self {
         let ladder = lattice.ladder(kind);
         FlatTorus {
+            lift: lattice.lift_level(&ladder),
             lattice,
             ladder,
             kind,
@@ -109,6 +113,7 @@ impl<const D: usize> FlatTorus<D> {
             .lattice
             .weighted_ladder(self.kind, need * (1.0 + 1e-9))?;
         Some(FlatTorus {
+            lift: self.lattice.lift_level(&ladder),
             lattice: self.lattice.clone(),
             ladder,
             kind: self.kind,
@@ -124,6 +129,20 @@ impl<const D: usize> FlatTorus<D> {
     /// The coverings of the ladder, from level 0 (most sheets) to the torus.
     pub fn ladder(&self) -> &[Level<D>] {
         &self.ladder
+    }
+
+    /// The level number of the lift covering, if any (after the ladder's).
+    pub(super) fn lift_index(&self) -> Option<usize> {
+        self.lift.as_ref().map(|_| self.ladder.len())
+    }
+
+    /// The covering of `level`: of the ladder, or after it the lift covering.
+    #[inline]
+    fn at(&self, level: usize) -> &Level<D> {
+        match self.ladder.get(level) {
+            Some(l) => l,
+            None => self.lift.as_ref().expect("a level of the torus"),
+        }
     }
 
     /// The torus of an axis-aligned box `[0,l_0) × … × [0,l_{D−1})`.
@@ -480,12 +499,12 @@ impl<const D: usize> FlatTorus<D> {
         if level == 0 {
             return f64::INFINITY;
         }
-        let r = self.ladder[level].systole / 4.0 * (1.0 - 1e-7);
+        let r = self.at(level).systole / 4.0 * (1.0 - 1e-7);
         r * r
     }
 
     pub(super) fn copies(&self, level: usize) -> Vec<[i8; D]> {
-        self.ladder[level]
+        self.at(level)
             .sub
             .copies()
             .into_iter()
@@ -496,16 +515,16 @@ impl<const D: usize> FlatTorus<D> {
     /// Translates the offsets of a cell by the group of the level's space into canonical form.
     #[inline]
     pub(super) fn normalize_offsets<const N: usize>(&self, off: &mut [[i8; D]; N], level: usize) {
-        self.ladder[level].sub.normalize(off)
+        self.at(level).sub.normalize(off)
     }
 
     pub(super) fn sheet_count(&self, level: usize) -> usize {
-        self.ladder[level].sub.index()
+        self.at(level).sub.index()
     }
 
     #[inline]
     pub(super) fn sheet(&self, o: [i8; D], level: usize) -> usize {
-        self.ladder[level].sub.sheet(widen(o))
+        self.at(level).sub.sheet(widen(o))
     }
 
     /// Every lifted copy of `pts` within `radius` of the lifted point `z` (generously).
@@ -539,7 +558,7 @@ impl<const D: usize> FlatTorus<D> {
     pub(super) fn edge_bound_of(&self, level: usize) -> f64 {
         if level > 0 {
             // circumradius < δ(H)/4 ⇒ edges < δ(H)/2
-            self.ladder[level].systole / 2.0
+            self.at(level).systole / 2.0
         } else {
             // largest empty ball of one point: diameter ≤ √(Σ|b_i|²)
             self.lattice
@@ -783,6 +802,10 @@ macro_rules! flat_torus_plugin {
 
         fn levels(&self) -> usize {
             self.ladder().len()
+        }
+
+        fn lift_level(&self) -> Option<usize> {
+            self.lift_index()
         }
 
         fn criterion_radius2(&self, level: usize) -> f64 {

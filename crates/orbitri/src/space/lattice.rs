@@ -482,6 +482,20 @@ impl<const D: usize> Lattice<D> {
         (ladder[0].systole > need).then_some(ladder)
     }
 
+    /// The covering of two copies along each vector, when a ladder's only covering has more
+    /// sheets (a 3D grid: 8 sheets against 27): its systole is twice the lattice's, so that
+    /// a point set with no empty ball of that systole's half (a slab beside a vacuum thinner
+    /// than the box) is triangulated there. It lies between level 0 and the torus but is no
+    /// cover of level 0, so it is never descended to: the engine lifts a quotient to it
+    /// (`Engine::unfold`) before trying level 0.
+    pub(crate) fn lift_level(&self, ladder: &[Level<D>]) -> Option<Level<D>> {
+        let sub = Sublattice::diagonal([2; D]);
+        (ladder.len() == 2 && sub.index() < ladder[0].sub.index()).then(|| Level {
+            systole: shortest_vector(&self.rows, &diagonal_basis([2; D])),
+            sub,
+        })
+    }
+
     /// The longest systole a diagonal covering of at most [`MAX_COPIES`] copies per vector
     /// reaches (internal frame).
     pub(crate) fn longest_covering_systole(&self) -> f64 {

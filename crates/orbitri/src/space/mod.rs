@@ -32,7 +32,7 @@ use std::hash::Hash;
 pub type Lifted<P, O> = (P, O);
 
 /// An orbit space whose triangulations have cells of `N` vertices.
-pub trait OrbitSpace<const N: usize>: Sync + Send {
+pub trait OrbitSpace<const N: usize>: Clone + Sync + Send {
     /// A point of the fundamental domain.
     type Point: Copy + Debug + PartialEq + Send + Sync;
     /// A group element, as stored per cell vertex (flat torus: an integer offset vector).
@@ -147,8 +147,16 @@ pub trait OrbitSpace<const N: usize>: Sync + Send {
     fn ortho_distance2(&self, s: &[Lifted<Self::Point, Self::Elem>; N], ws: &[f64; N]) -> f64;
     /// Number of levels of the covering ladder: level 0 is a covering in which every
     /// non-empty point set has a Delaunay triangulation, each next level has fewer sheets, and
-    /// the last is the orbit space itself (1 sheet).
+    /// the last is the orbit space itself (1 sheet). A lift level, if any, is numbered
+    /// `levels()` ([`OrbitSpace::lift_level`]).
     fn levels(&self) -> usize;
+    /// A covering with fewer sheets than level 0, outside the ladder (no cover of level 0,
+    /// so never descended to), to which a quotient is lifted when points cannot leave it in
+    /// place: its level number (`levels()`, after the ladder's), every per-level method
+    /// answering for it. `None` when there is none.
+    fn lift_level(&self) -> Option<usize> {
+        None
+    }
     /// Squared circumradius below which every cell allows `level`: then the level's space
     /// is triangulated for this point set and every superset (Corollary 9 of Caroli–Teillaud,
     /// `Δ < δ(H)/2`, i.e. radius `< δ(H)/4`), with a safety margin. Infinite for level 0.
