@@ -139,7 +139,7 @@ impl OrbitSpace<4> for FlatTorus<3> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::space::FlatTorus3;
+    use crate::space::{FlatTorus2, FlatTorus3, Ladder};
 
     fn unit() -> FlatTorus3 {
         FlatTorus3::cuboid([1.0; 3]).unwrap()
@@ -254,6 +254,44 @@ mod tests {
         assert_eq!(off, [[1, 2, 0], [0, 3, 0], [1, 3, 1], [0, 3, 0]]);
         assert_eq!(t.covering_copies(0).len(), 27);
         assert_eq!(t.levels(), 2);
+    }
+
+    /// The lift level: two copies along each vector, after the ladder's levels, with twice
+    /// the torus's systole; weighted tori keep it; a 2D torus has one only on the grid
+    /// ladder (the halving ladder's levels lie between level 0 and the torus already).
+    #[test]
+    fn the_lift_level_has_two_copies_along_each_vector() {
+        for t in [unit(), unit().for_spread(0.01).unwrap()] {
+            let lift = t.lift_level().expect("a 3D torus has a lift level");
+            assert_eq!(lift, t.levels());
+            assert_eq!(t.sheets(lift), 8);
+            let mut copies = t.covering_copies(lift);
+            copies.sort_unstable();
+            let want: Vec<[i8; 3]> = (0..8).map(|k| [k >> 2 & 1, k >> 1 & 1, k & 1]).collect();
+            assert_eq!(copies, want);
+            let quotient = t.criterion_radius2(t.levels() - 1);
+            assert!((t.criterion_radius2(lift) / quotient - 4.0).abs() < 1e-12);
+            let bound = t.edge_bound(t.levels() - 1);
+            assert!((t.edge_bound(lift) - 2.0 * bound).abs() < 1e-12);
+            // the canonical form moves a cell by one element of 2ℤ³, and is kept
+            let was = [[3i8, -1, 2], [2, 0, 2], [3, 0, 3], [2, 0, 2]];
+            let mut off = was;
+            t.normalize(&mut off, lift);
+            let by: [i8; 3] = std::array::from_fn(|c| off[0][c] - was[0][c]);
+            assert!(by.iter().all(|x| x % 2 == 0));
+            assert!((0..4).all(|i| (0..3).all(|c| off[i][c] - was[i][c] == by[c])));
+            let again = off;
+            t.normalize(&mut off, lift);
+            assert_eq!(off, again);
+            let sheets: std::collections::BTreeSet<usize> =
+                copies.iter().map(|&o| t.sheet_of(o, lift)).collect();
+            assert_eq!(sheets.len(), 8);
+        }
+        let square = FlatTorus2::cuboid([1.0; 2]).unwrap();
+        assert_eq!(OrbitSpace::<3>::lift_level(&square), None);
+        let grid = FlatTorus2::with_ladder(square.lattice.clone(), Ladder::Grid);
+        let lift = OrbitSpace::<3>::lift_level(&grid).expect("the grid ladder has one");
+        assert_eq!(OrbitSpace::<3>::sheets(&grid, lift), 4);
     }
 
     /// Slivers: four points near one circle, lifted off its plane by `h`. The circumradius
