@@ -240,8 +240,9 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     }
 
     /// Replaces the covering triangulation by its projection to the space of a later
-    /// `level` (from the lift level, the quotient): one cell per orbit of cells under that space's group, vertex ids renumbered
-    /// for its sheets. The caller guarantees the projection is simplicial.
+    /// `level` (from the lift level, the quotient): one cell per orbit of cells under that
+    /// space's group, vertex ids renumbered for its sheets. The caller guarantees the
+    /// projection is simplicial.
     pub(crate) fn convert(&mut self, level: usize) {
         // (from the lift level, after the ladder's, to the quotient)
         if level <= self.level && self.level <= self.last_level() {

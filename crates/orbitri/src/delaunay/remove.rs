@@ -131,7 +131,6 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         // the quotient and the points left as they were when lifted to the space's lift
         // level: if one cannot leave there either, level 0 takes them from it
         let mut before_lift: Option<(Box<Self>, Vec<usize>)> = None;
-        let mut lifted = false;
         while !left.is_empty() {
             let before = left.len();
             let mut refused = Vec::new();
@@ -154,8 +153,9 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                     return None;
                 }
                 match self.space.lift_level() {
-                    Some(lift) if !lifted && self.lift_may_do(&left, k, lift) => {
-                        lifted = true;
+                    // (only the quotient gets here before a lift: a refusal at level 0
+                    // cannot happen, above it returns)
+                    Some(lift) if self.one_sheeted && self.lift_may_do(&left, k, lift) => {
                         before_lift = Some((Box::new(self.clone()), left.clone()));
                         self.unfold(lift);
                     }
@@ -163,7 +163,6 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                         if let Some((quotient, was_left)) = before_lift.take() {
                             (*self, left) = (*quotient, was_left);
                         }
-                        lifted = true;
                         // (in the covering of level 0 every removal goes in place)
                         self.unfold(0);
                     }
@@ -207,69 +206,95 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     }
 
     /// Whether the points `left` of the quotient (dummy points, ids below `k`) look able
-    /// to leave in the covering of `lift`. First, every cell must keep that level's
-    /// criterion (radius below `r`), so that its covering is triangulated for the points
-    /// and every superset: true when the quotient's holds, checked otherwise (removals in
-    /// the quotient may have left larger cells). Then the other points (ids `k` and more)
-    /// must leave no empty ball of radius `r`. With the quotient's criterion, the centre of
-    /// such a ball is in the Voronoi region of a point of `left` (it is further than the
-    /// quotient's radius from every other point), within the largest circumradius of its
-    /// star; so those balls are sampled on a grid of step `r/10`, each sample against the
-    /// other points among the dummy's neighbours and among the neighbours of its dummy
-    /// neighbours. A sample further than `r` from them says no. (An estimate: a nearer
-    /// point may lie further out, and a ball may slip between samples; a wrong guess costs
-    /// time, not the result, as what cannot leave there leaves from level 0.)
+    /// to leave in the covering of `lift`, whose criterion bounds circumradii by `r`.
+    /// First the other points (ids `k` and more) must leave no empty ball of radius `r`
+    /// ([`Self::surrounded`] for each point of `left`: one sample uncovered says no). Then
+    /// every cell must keep the criterion, so that the covering is triangulated for the
+    /// points and every superset: true when the quotient's holds, checked otherwise
+    /// (removals in the quotient may have left larger cells; this pass over every cell
+    /// costs far more than the samples, so it comes after them). An estimate: a wrong
+    /// guess costs time, not the result, as what cannot leave there leaves from level 0.
     fn lift_may_do(&self, left: &[usize], k: usize, lift: usize) -> bool {
         let limit = self.space.criterion_radius2(lift);
-        if !self.guaranteed {
-            let ids: Vec<CellId> = self.tds.ids().collect();
-            if !ids.par_iter().all(|&c| self.cell_radius2(c) < limit) {
-                return false;
-            }
+        if !left
+            .iter()
+            .all(|&d| self.surrounded(PointId::new(d), k, limit))
+        {
+            return false;
         }
-        let step = limit.sqrt() / 10.0;
+        if self.guaranteed {
+            return true;
+        }
+        let ids: Vec<CellId> = self.tds.ids().collect();
+        ids.par_iter().all(|&c| self.cell_radius2(c) < limit)
+    }
+
+    /// Whether the Voronoi region of dummy point `d` (an id below `k`) looks covered by
+    /// the balls of squared radius `limit` about the other points (ids `k` and more). The
+    /// region lies within the largest circumradius of the point's star, so that ball is
+    /// sampled on a grid of a tenth of the radius, each sample against the other points
+    /// among the point's neighbours, then, for the samples those leave, among the
+    /// neighbours of its dummy neighbours (whose stars, around a void, are large). (A
+    /// nearer point may lie further out, and a ball may slip between samples.)
+    fn surrounded(&self, d: PointId, k: usize, limit: f64) -> bool {
         let position = |q: VertexId, o| {
             let p = self.points[self.vpoint[q.index()].index()];
             self.space.ball_position((p, o)).map(|(at, _)| at)
         };
         let dummy = |q: VertexId| self.vpoint[q.index()].index() < k;
         let dist2 = |a: &[f64; 3], b: &[f64; 3]| (0..3).map(|c| (a[c] - b[c]).powi(2)).sum::<f64>();
-        left.iter().all(|&d| {
-            let v = self.vertex_of_point(PointId::new(d));
-            let Some(centre) = position(v, self.space.identity()) else {
-                return false;
-            };
-            // the other points near `d`, relative to it, nearest first
-            let mut near = Vec::new();
-            for (u, to_u) in self.neighbours(v) {
-                if !dummy(u) {
-                    near.extend(position(u, to_u));
-                    continue;
-                }
-                for (w, to_w) in self.neighbours(u) {
-                    if !dummy(w) {
-                        near.extend(position(w, self.space.compose(to_u, to_w)));
+        let v = self.vertex_of_point(d);
+        let Some(centre) = position(v, self.space.identity()) else {
+            return false;
+        };
+        // the other points, relative to `d`, nearest first
+        let nearest_first = |mut near: Vec<[f64; 3]>| {
+            near.sort_by(|a, b| dist2(a, &centre).total_cmp(&dist2(b, &centre)));
+            near
+        };
+        let star = self.star(v);
+        let link = self.link_vertices(&star);
+        let near = nearest_first(
+            link.iter()
+                .filter(|&&(u, _)| !dummy(u))
+                .filter_map(|&(u, to_u)| position(u, to_u))
+                .collect(),
+        );
+        let mut further: Option<Vec<[f64; 3]>> = None;
+        let reach2 = star
+            .iter()
+            .map(|&(c, _, _)| self.cell_radius2(c))
+            .fold(0.0, f64::max);
+        let step = limit.sqrt() / 10.0;
+        let n = (reach2.sqrt() / step).ceil().min(64.0) as i32;
+        let depth = if N == 4 { n } else { 0 };
+        for a in -n..=n {
+            for b in -n..=n {
+                for c in -depth..=depth {
+                    let x = [a, b, c].map(|t| f64::from(t) * step);
+                    let x: [f64; 3] = std::array::from_fn(|i| centre[i] + x[i]);
+                    let covered = |near: &[[f64; 3]]| near.iter().any(|q| dist2(q, &x) < limit);
+                    if dist2(&x, &centre) > reach2 || covered(&near) {
+                        continue;
+                    }
+                    let further = further.get_or_insert_with(|| {
+                        let mut out = Vec::new();
+                        for &(u, to_u) in link.iter().filter(|&&(u, _)| dummy(u)) {
+                            for (w, to_w) in self.neighbours(u) {
+                                if !dummy(w) {
+                                    out.extend(position(w, self.space.compose(to_u, to_w)));
+                                }
+                            }
+                        }
+                        nearest_first(out)
+                    });
+                    if !covered(further) {
+                        return false;
                     }
                 }
             }
-            near.sort_by(|a, b| dist2(a, &centre).total_cmp(&dist2(b, &centre)));
-            let star = self.star(v);
-            let reach2 = star
-                .iter()
-                .map(|&(c, _, _)| self.cell_radius2(c))
-                .fold(0.0, f64::max);
-            let n = (reach2.sqrt() / step).ceil().min(64.0) as i32;
-            let depth = if N == 4 { n } else { 0 };
-            (-n..=n).all(|a| {
-                (-n..=n).all(|b| {
-                    (-depth..=depth).all(|c| {
-                        let x = [a, b, c].map(|t| f64::from(t) * step);
-                        let x: [f64; 3] = std::array::from_fn(|i| centre[i] + x[i]);
-                        dist2(&x, &centre) > reach2 || near.iter().any(|q| dist2(q, &x) < limit)
-                    })
-                })
-            })
-        })
+        }
+        true
     }
 
     /// True when point `d` of the 1-sheeted triangulation has a vertex (a dummy point that
