@@ -216,7 +216,8 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// simplicial complex: no edge joins two copies of one point, and no two edges join the
     /// same two points with different relative offsets (no cycle of length ≤ 2). The
     /// covering triangulation is invariant under the group of its sheets, so the star of
-    /// one copy of each point tells (not every cell of every sheet).
+    /// one copy of each point tells (not every cell of every sheet). Points without a
+    /// vertex are skipped.
     pub fn quotient_is_simplicial(&self) -> bool {
         if self.one_sheeted {
             return true;
@@ -227,7 +228,12 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             .with_min_len(1024)
             .map_init(Vec::new, |edges: &mut Vec<(PointId, S::Elem)>, p| {
                 edges.clear();
-                for (c, i, _) in self.star(VertexId(p * sheets)) {
+                // (a point without a vertex, gone or hidden, has no edge)
+                let v = VertexId(p * sheets);
+                if self.vcell[v.index()] == CellId::NONE {
+                    return true;
+                }
+                for (c, i, _) in self.star(v) {
                     let cell = self.tds.cell(c);
                     for k in (0..N).filter(|&k| k != i) {
                         let rel = self.space.relative(cell.off[k], cell.off[i]);

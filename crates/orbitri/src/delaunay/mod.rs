@@ -101,6 +101,19 @@ pub struct HiddenPoint<P> {
     pub weight: f64,
 }
 
+/// How removals go at the space's lift level (see `Engine::remove_first_points`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Lift {
+    /// Its criterion is known to hold, so that the covering is a triangulation for the
+    /// points and every superset: each removal keeps it.
+    Criterion,
+    /// Without it: the points below `stays` leave, each removal checked to keep the
+    /// covering simplicial, and the others must reach the quotient.
+    Checked { stays: usize },
+    /// A removal showed that the points that stay cannot reach the quotient.
+    Lost,
+}
+
 /// A Delaunay triangulation of an orbit space.
 #[derive(Clone, Debug)]
 pub struct Engine<S: OrbitSpace<N>, const N: usize> {
@@ -134,6 +147,8 @@ pub struct Engine<S: OrbitSpace<N>, const N: usize> {
     /// True while the switch criterion is known to hold, so that further insertions keep a
     /// valid 1-sheeted triangulation.
     pub(crate) guaranteed: bool,
+    /// How removals go at the space's lift level ([`OrbitSpace::lift_level`]).
+    lift: Lift,
     /// While the criterion of the next level (of the quotient once there) is not known to
     /// hold: cells whose circumradius is too large for it, and their number.
     big: Vec<bool>,
@@ -188,6 +203,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             level: 0,
             one_sheeted: false,
             guaranteed: false,
+            lift: Lift::Criterion,
             big: Vec::new(),
             big_count: 0,
             hint: CellId(0),
