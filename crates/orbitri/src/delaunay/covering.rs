@@ -344,7 +344,8 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// triangulation, so that the points whose removal would break the quotient can go
     /// (thesis §2.3.1: the dummy points left are removed after a conversion to the
     /// 27-sheeted covering, not by triangulating every point again), or the space's lift
-    /// level ([`OrbitSpace::lift_level`]), where they can while its criterion holds. The
+    /// level ([`OrbitSpace::lift_level`]), where they can while its criterion or its
+    /// simplicial complex holds (see `Engine::remove_first_points`). The
     /// copy of a cell by `t` meets, across each facet, the copy of that neighbour by `t`
     /// composed with the element between their frames; a copy is large for the next
     /// level's criterion when its cell is.

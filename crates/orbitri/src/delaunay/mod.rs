@@ -589,17 +589,8 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
 
     /// The neighbours of vertex `v`: each (vertex, its offset relative to `v`) once, sorted.
     pub fn neighbours(&self, v: VertexId) -> Vec<(VertexId, S::Elem)> {
-        self.link_vertices(&self.star(v))
-    }
-
-    /// The vertices of a vertex's `star` other than it: each (vertex, its offset relative
-    /// to the star's vertex) once, sorted.
-    pub(crate) fn link_vertices(
-        &self,
-        star: &[(CellId, usize, S::Elem)],
-    ) -> Vec<(VertexId, S::Elem)> {
         let mut out = Vec::new();
-        for &(c, k, _) in star {
+        for (c, k, _) in self.star(v) {
             let cell = self.tds.cell(c);
             for j in (0..N).filter(|&j| j != k) {
                 out.push((cell.v[j], self.space.relative(cell.off[j], cell.off[k])));
