@@ -117,9 +117,9 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// criterion while they can (then the covering stays a triangulation for every
     /// superset), and once a round removes none that way, or at once if the quotient's
     /// cells break it, each is checked instead to keep the covering simplicial, and the
-    /// points left must then reach the quotient ([`Self::try_one_sheet`]). Else, or when one cannot leave there after all, the
-    /// points go on in the covering of level 0 (from the quotient as it was), where every
-    /// removal goes in place. Then the last point takes each one's id, largest first: the
+    /// points left must then reach the quotient ([`Self::try_one_sheet`]). Else, or when
+    /// one cannot leave there after all, the points go on in the covering of level 0 (from
+    /// the quotient as it was), where every removal goes in place. Then the last point takes each one's id, largest first: the
     /// other points keep theirs, so only the cells around the `k` moved points are
     /// rewritten, where renumbering all in order ([`Self::compact`]) rewrites every cell.
     /// Returns, for each id `d < k`, the first id of the point last moved into it (a point
@@ -133,8 +133,8 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         let mut left: Vec<usize> = (0..k).rev().filter(|&d| self.has_vertex(d)).collect();
         // the quotient and the points left as they were when lifted to the space's lift
         // level: if they cannot leave there, level 0 takes them from it
-        let mut before_lift: Kept<Self> = None;
         type Kept<E> = Option<(Box<E>, Vec<usize>)>;
+        let mut before_lift: Kept<Self> = None;
         let from_level_0 = |e: &mut Self, left: &mut Vec<usize>, kept: &mut Kept<Self>| {
             if let Some((quotient, was_left)) = kept.take() {
                 (*e, *left) = (*quotient, was_left);
@@ -307,11 +307,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             let mut filled = Vec::new();
             for (g, &t) in by_sheet.iter().enumerate() {
                 stars.extend(self.star(moved(g, first)).iter().map(|s| s.0));
-                filled.extend(cells.iter().map(|w| Wrapped {
-                    vids: w.vids.map(|u| moved(g, u)),
-                    arr: w.arr.map(|(x, o)| (x, self.space.compose(t, o))),
-                    links: w.links,
-                }));
+                filled.extend(cells.iter().map(|w| self.moved_cell(w, t, |u| moved(g, u))));
             }
             stars.sort_unstable();
             if !self.removal_keeps_simplicial(&stars, &filled, Some(k)) {
@@ -340,17 +336,15 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             let copied: Filling<S, N> = cells
                 .iter()
                 .map(|w| {
-                    let vids = w.vids.map(moved);
-                    let mut links = w.links;
-                    for (m, link) in links.iter_mut().enumerate() {
+                    let mut w = self.moved_cell(w, t, moved);
+                    for (m, link) in w.links.iter_mut().enumerate() {
                         if let Some(Owner::Old(..)) = link {
-                            let old = across.get(&facet_key(&vids, m)).copied();
+                            let old = across.get(&facet_key(&w.vids, m)).copied();
                             ok &= old.is_some();
                             *link = old.map(|(d, j)| Owner::Old(d, j));
                         }
                     }
-                    let arr = w.arr.map(|(x, o)| (x, self.space.compose(t, o)));
-                    Wrapped { vids, arr, links }
+                    w
                 })
                 .collect();
             debug_assert!(ok, "the copies' stars are congruent");
@@ -361,6 +355,21 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             }
         }
         Some(true)
+    }
+
+    /// A cell of a hole's filling moved by the element `t` of the sheets' group, its
+    /// vertices renamed by `moved`, its links as they were.
+    fn moved_cell(
+        &self,
+        w: &Wrapped<S::Point, S::Elem, N>,
+        t: S::Elem,
+        moved: impl Fn(VertexId) -> VertexId,
+    ) -> Wrapped<S::Point, S::Elem, N> {
+        Wrapped {
+            vids: w.vids.map(moved),
+            arr: w.arr.map(|(x, o)| (x, self.space.compose(t, o))),
+            links: w.links,
+        }
     }
 
     /// At the lift level without its criterion: the points below this id are leaving, each
