@@ -76,7 +76,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// the vertex of its neighbour `e` across from the new vertex, and that vertex's slot,
     /// when `e` is in conflict with the new point `p`: the edge between them is to flip.
     #[inline(always)]
-    fn far_in_conflict(
+    pub(super) fn far_in_conflict(
         &self,
         t: CellId,
         tc: &Cell<S::Elem, N>,
@@ -96,7 +96,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// A triangle in canonical form (see [`Self::canonicalize`]: in an orientable space, no
     /// slot moves), as a cell.
     #[inline(always)]
-    fn canonical_triangle(&self, (v, off, n): Triangle<S::Elem>) -> Cell<S::Elem, N> {
+    pub(super) fn canonical_triangle(&self, (v, off, n): Triangle<S::Elem>) -> Cell<S::Elem, N> {
         let mut cell = Cell::new(tri(v), tri(off));
         self.canonicalize(&mut cell);
         cell.n = tri(n);
@@ -119,12 +119,12 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
 }
 
 /// A triangle as the flips build it: vertices, elements, neighbours.
-type Triangle<O> = ([VertexId; 3], [O; 3], [CellId; 3]);
+pub(super) type Triangle<O> = ([VertexId; 3], [O; 3], [CellId; 3]);
 
 /// The triangles that splitting cell `old` at vertex `x` (element `qo`) makes, for the
 /// slots `[c, b, d]` (`c` is `old`'s): `x` in place of each vertex in turn, rotated to
 /// slot 0, each linked to the neighbour across its edge and to the other two.
-fn split<O: Copy, const N: usize>(
+pub(super) fn split<O: Copy, const N: usize>(
     old: &Cell<O, N>,
     x: VertexId,
     qo: O,
@@ -150,7 +150,7 @@ fn split<O: Copy, const N: usize>(
 /// left `e`, with the outside cell now across from the new vertex in `t` (it was linked to
 /// `e`), and the second end, which left `t`, with the outside cell now at slot 1 of `e`
 /// (it was linked to `t`).
-fn flipped<O: Copy, const N: usize>(
+pub(super) fn flipped<O: Copy, const N: usize>(
     tc: &Cell<O, N>,
     (e, ec, j): (CellId, &Cell<O, N>, usize),
     far: O,

@@ -2,17 +2,21 @@
 //!
 //! The points arrive in BRIO + Hilbert order. After a short sequential start they go in
 //! waves, each of the next as many points as there are (so that a wave at most doubles the
-//! triangulation); when fewer than a 32nd of the points are left in the call (a BRIO
-//! round), they go one at a time. A wave is sorted along the Hilbert curve and cut into
+//! triangulation), or where the chunks flip (below) the rest of the call (a BRIO round,
+//! eightfold in 2D: consecutive points then land in the cells just made, which halved the
+//! chunks' cost a point); when fewer than a 32nd of the points are left in the call, they
+//! go one at a time. A wave is sorted along the Hilbert curve and cut into
 //! [`CHUNKS`] chunks of consecutive points, and each chunk **owns** the cells of its stretch
 //! of the curve: a cell belongs to the chunk whose range holds the spatial key of its
 //! vertex 0, and a new cell to the chunk that made it. A chunk inserts its points one after
 //! another, as a sequential insertion would (each walk starts from its last insertion, or
 //! every 64th, and in the group passes below every one, from a cell located before the
 //! pass), but only where it owns everything it reads or writes: the walk, the conflict
-//! region and the cells across its boundary. A
-//! point that needs another chunk's cell, or whose 3D star the ridge table refuses, is
-//! deferred. The chunks run on the threads in any order and at once, with no lock: a cell
+//! region and the cells across its boundary. Where the sequential code splits and flips
+//! ([`Engine::flips`]: the flat 2D tori), a chunk does too, for a point strictly inside a
+//! triangle: every cell it flips and every cell it relinks must be its own, and its writes
+//! are journaled and undone when a flip meets another chunk's cell. A point that needs
+//! another chunk's cell, or whose 3D star the ridge table refuses, is deferred. The chunks run on the threads in any order and at once, with no lock: a cell
 //! next to a chunk's own cell cannot change while it is, since changing it would write the
 //! chunk's cell.
 //!
@@ -43,6 +47,7 @@ use std::sync::atomic::{AtomicU32, AtomicUsize};
 
 use rayon::prelude::*;
 
+use super::flip::{flipped, split};
 use super::insert::{closes, edge_ends, enter, next_edge, slot_in, Frame, Refused};
 use super::ridges::Ridges;
 use super::{Engine, HiddenPoint, Inserted};
@@ -124,6 +129,8 @@ enum Found {
     Foreign,
     /// Its conflict region is collected, and the chunk owns it.
     Region,
+    /// 2D: inserted already, by splitting its triangle and flipping.
+    Flipped,
 }
 
 /// What became of a point of the wave.
@@ -187,6 +194,11 @@ struct Chunk<O: Packing, const N: usize> {
     orphans: Vec<VertexId>,
     /// 3D: the boundary edges of its region, to pair the new cells.
     ridges: Ridges,
+    /// 2D flips: the cells whose edge opposite the new vertex is still to test, and what
+    /// was overwritten (cells, then vertices' cells), to undo a point stopped halfway.
+    edges: Vec<CellId>,
+    journal: Vec<(CellId, Stored<O, N>)>,
+    moved: Vec<(VertexId, u32)>,
 }
 
 impl<O: Packing, const N: usize> Chunk<O, N> {
@@ -214,7 +226,86 @@ impl<O: Packing, const N: usize> Chunk<O, N> {
             ids: Vec::new(),
             orphans: Vec::new(),
             ridges: Ridges::default(),
+            edges: Vec::new(),
+            journal: Vec::new(),
+            moved: Vec::new(),
         }
+    }
+
+    /// A slot for a new cell: a spare one, else a fresh one (the caller checked that there
+    /// is one).
+    #[inline(always)]
+    fn take_slot(&mut self) -> CellId {
+        take_slot(&mut self.spare, &mut self.fresh)
+    }
+
+    /// Writes `cell` into slot `c` of the pass's store, stamped `stamp` (or keeping its
+    /// stamp), journaled; false, with nothing written, when its elements do not pack.
+    ///
+    /// # Safety
+    /// The chunk owns `c` (or it is one of its slots).
+    #[inline(always)]
+    unsafe fn rewrite(
+        &mut self,
+        cells: &SharedCells<O, N>,
+        c: CellId,
+        cell: &Cell<O, N>,
+        stamp: Option<u32>,
+    ) -> bool {
+        let slot = &mut *cells.get(c);
+        let was = *slot;
+        if !slot.set(cell) {
+            return false;
+        }
+        if let Some(s) = stamp {
+            slot.set_stamp(s);
+        }
+        self.journal.push((c, was));
+        true
+    }
+
+    /// Links facet `i` of `a` (written already) with the facet of `d` that was linked to
+    /// `old`, journaled.
+    ///
+    /// # Safety
+    /// The chunk owns `a` and `d`.
+    #[inline(always)]
+    unsafe fn relink(
+        &mut self,
+        cells: &SharedCells<O, N>,
+        (a, i): (CellId, usize),
+        d: CellId,
+        old: CellId,
+    ) {
+        let cell = &mut *cells.get(d);
+        let j = cell.mirror(old).expect("symmetric neighbours");
+        self.journal.push((d, *cell));
+        cell.n[j] = a;
+        (*cells.get(a)).n[i] = d;
+    }
+
+    /// Points vertex `v` at cell `to` if it points at `from`, journaled (`from` is the
+    /// chunk's, so no other chunk moves `v` meanwhile).
+    #[inline(always)]
+    fn move_vertex(&mut self, vcell: &[AtomicU32], v: VertexId, from: CellId, to: CellId) {
+        if vcell[v.index()].load(Relaxed) == from.0 {
+            self.moved.push((v, from.0));
+            vcell[v.index()].store(to.0, Relaxed);
+        }
+    }
+
+    /// Undoes the journaled writes, last first, and gives back the slots `new`.
+    ///
+    /// # Safety
+    /// The journal's cells are still the chunk's.
+    unsafe fn undo(&mut self, cells: &SharedCells<O, N>, vcell: &[AtomicU32], new: [CellId; 2]) {
+        for &(c, cell) in self.journal.iter().rev() {
+            *cells.get(c) = cell;
+        }
+        for &(v, was) in self.moved.iter().rev() {
+            vcell[v.index()].store(was, Relaxed);
+        }
+        self.spare.extend(new.into_iter().rev());
     }
 
     /// The chunk's next visit mark, taken; `None` when it has none left.
@@ -416,11 +507,12 @@ impl<S: OrbitSpace<N>, const N: usize> Pass<'_, S, N> {
                     }
                 }
             }
-            self.engine
-                .probe(self.wave[s], ch, &self.own, &self.cells, self.vcell);
+            let x = VertexId::new(self.base + s);
+            let at = (&self.cells, self.vcell, stamp);
+            self.engine.probe(self.wave[s], x, ch, &self.own, at);
             let outcome = match ch.found {
+                Found::Flipped => Outcome::New,
                 Found::Region => {
-                    let x = VertexId::new(self.base + s);
                     let e = self.engine;
                     match commit(&e.space, e.level, &self.cells, self.vcell, stamp, ch, x) {
                         Commit::Starred => Outcome::New,
@@ -507,7 +599,12 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 break;
             }
             if self.wave_ready(items.len() - k) {
-                let m = (items.len() - k).min(self.points.len());
+                // (where the chunks flip, a whole round: see the module's comment)
+                let m = if self.flips() {
+                    items.len() - k
+                } else {
+                    (items.len() - k).min(self.points.len())
+                };
                 self.wave(items, k..k + m, &mut shared, &mut log);
                 k += m;
                 continue;
@@ -901,10 +998,10 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     fn probe(
         &self,
         (_, p, _, key): Item<S::Point>,
+        x: VertexId,
         ch: &mut Chunk<S::Elem, N>,
         own: &Ownership,
-        cells: &SharedCells<S::Elem, N>,
-        vcell: &[AtomicU32],
+        (cells, vcell, stamp): (&SharedCells<S::Elem, N>, &[AtomicU32], u32),
     ) {
         let me = ch.id;
         let met = std::cell::Cell::new(None);
@@ -922,10 +1019,16 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             return;
         };
         let mut rng = SplitMix::new(key);
-        let Some((c0, q0, _)) = self.walk_within((p, shift), c, &mut rng, owned) else {
+        let Some((c0, q0, strict)) = self.walk_within((p, shift), c, &mut rng, owned) else {
             ch.foreign = met.get();
             return;
         };
+        if strict && self.flips() {
+            // SAFETY: the pass's cells; the chunk writes only cells it owns and its slots.
+            let at = (cells, vcell, stamp);
+            ch.found = unsafe { self.split_in_chunk(p, (c0, q0), x, ch, own, at) };
+            return;
+        }
         if let Some(v) = self.coincident_vertex(c0, (p, q0), 0.0) {
             ch.found = Found::Duplicate(self.vpoint[v.index()]);
             ch.hint = Some((c0, self.tds.cells[c0.index()].v, q0));
@@ -948,6 +1051,105 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 Found::Region
             };
         }
+    }
+
+    /// 2D, where [`Engine::flips`]: inserts `x` at `p`, strictly inside the chunk's cell
+    /// `c0` lifted by `q0`, by splitting it and flipping as [`Engine::split_and_flip`]
+    /// does, reading only cells the chunk owns and the stamps of their neighbours, and
+    /// writing only cells it owns (new ones stamped `stamp`). Each write is journaled and
+    /// all are undone when a flip needs another chunk's cell (`Foreign`, with
+    /// `ch.foreign`), a new triangle's elements do not pack, or the chunk has no two slots
+    /// left (`Foreign`, `ch.full`).
+    ///
+    /// # Safety
+    /// `cells` is the pass's store, in which no other chunk writes the cells this one owns.
+    unsafe fn split_in_chunk(
+        &self,
+        p: S::Point,
+        (c0, q0): (CellId, S::Elem),
+        x: VertexId,
+        ch: &mut Chunk<S::Elem, N>,
+        own: &Ownership,
+        (cells, vcell, stamp): (&SharedCells<S::Elem, N>, &[AtomicU32], u32),
+    ) -> Found {
+        if ch.spare.len() + ch.fresh.len() < 2 {
+            ch.full = true;
+            return Found::Foreign;
+        }
+        let me = ch.id;
+        let foreign = |c: CellId| {
+            let st = (*cells.get(c)).stamp();
+            (own.owner(st) != me).then(|| own.chunk(st))
+        };
+        let old = self.tds.cell(c0);
+        // (the first neighbour is tested by the first flip; the other two get new links)
+        if let Some(k) = old.n.iter().find_map(|&n| foreign(n)) {
+            ch.foreign = Some(k);
+            return Found::Foreign;
+        }
+        ch.journal.clear();
+        ch.moved.clear();
+        let (b, d) = (ch.take_slot(), ch.take_slot());
+        let mut stopped = None;
+        for (id, t) in [c0, b, d].into_iter().zip(split(&old, x, q0, [c0, b, d])) {
+            let stamp = (id != c0).then_some(stamp);
+            if !ch.rewrite(cells, id, &self.canonical_triangle(t), stamp) {
+                stopped = Some(None);
+                break;
+            }
+        }
+        if stopped.is_none() {
+            ch.relink(cells, (b, 0), old.n[1], c0);
+            ch.relink(cells, (d, 0), old.n[2], c0);
+            ch.move_vertex(vcell, old.v[0], c0, b);
+            let mut edges = std::mem::take(&mut ch.edges);
+            edges.clear();
+            edges.extend([c0, b, d]);
+            while let Some(t) = edges.pop() {
+                let tc = self.tds.cell(t);
+                let e = tc.n[0];
+                if let Some(k) = foreign(e) {
+                    stopped = Some(Some(k));
+                    break;
+                }
+                let Some((far, j)) = self.far_in_conflict(t, &tc, e, p) else {
+                    continue;
+                };
+                let ec = self.tds.cell(e);
+                let ([nt, ne], [(first, o1), (second, o2)]) = flipped(&tc, (e, &ec, j), far, t);
+                if let Some(k) = foreign(o1).or_else(|| foreign(o2)) {
+                    stopped = Some(Some(k));
+                    break;
+                }
+                if !ch.rewrite(cells, t, &self.canonical_triangle(nt), None)
+                    || !ch.rewrite(cells, e, &self.canonical_triangle(ne), None)
+                {
+                    stopped = Some(None);
+                    break;
+                }
+                ch.relink(cells, (t, 0), o1, e);
+                ch.relink(cells, (e, 1), o2, t);
+                ch.move_vertex(vcell, first, e, t);
+                ch.move_vertex(vcell, second, t, e);
+                edges.extend([t, e]);
+            }
+            ch.edges = edges;
+        }
+        if let Some(k) = stopped {
+            ch.undo(cells, vcell, [b, d]);
+            #[cfg(test)]
+            tests::UNDONE.with(|n| n.set(n.get() + 1));
+            ch.foreign = k;
+            return Found::Foreign;
+        }
+        vcell[x.index()].store(c0.0, Relaxed);
+        let shift = self
+            .space
+            .carry(self.space.identity(), self.tds.off_at(c0, 0));
+        ch.hint = Some((c0, self.tds.cells[c0.index()].v, shift));
+        #[cfg(test)]
+        tests::FLIPPED.with(|n| n.set(n.get() + 1));
+        Found::Flipped
     }
 
     /// 2D: the conflict region of `p` from cell `c0` (holding it lifted by `q0`) by
@@ -1152,11 +1354,7 @@ unsafe fn commit<S: OrbitSpace<N>, const N: usize>(
     ids.clear();
     ids.extend(ch.conflict.iter().map(|&(c, _)| c).take(ch.boundary.len()));
     while ids.len() < ch.boundary.len() {
-        let id = ch.spare.pop().unwrap_or_else(|| {
-            ch.fresh.start += 1;
-            CellId::new(ch.fresh.start - 1)
-        });
-        ids.push(id);
+        ids.push(take_slot(&mut ch.spare, &mut ch.fresh));
     }
     for &(a, i, b, j) in pairs {
         new[a as usize].n[i as usize] = ids[b as usize];
@@ -1198,6 +1396,16 @@ unsafe fn commit<S: OrbitSpace<N>, const N: usize>(
     Commit::Starred
 }
 
+/// A slot for a new cell: a spare one, else a fresh one (the caller checked that there
+/// is one).
+#[inline(always)]
+fn take_slot(spare: &mut Vec<CellId>, fresh: &mut Range<usize>) -> CellId {
+    spare.pop().unwrap_or_else(|| {
+        fresh.start += 1;
+        CellId::new(fresh.start - 1)
+    })
+}
+
 /// Adds to `orphans` the vertices `v` of region cell `c` whose cell it is (the commit
 /// points them at a new cell; no other chunk writes their cells meanwhile, since they
 /// point at none of their regions).
@@ -1216,7 +1424,78 @@ mod tests {
     use super::{Ownership, FEWEST};
     use crate::delaunay::{uniform_cube, Engine};
     use crate::sort::SplitMix;
-    use crate::space::{FlatTorus3, OrbitSpace};
+    use crate::space::{FlatTorus2, FlatTorus3, OrbitSpace};
+    use std::cell::Cell;
+    use std::collections::BTreeSet;
+
+    thread_local! {
+        /// Points the 2D chunks that ran on this thread inserted by flips, and flips they
+        /// undid.
+        pub(super) static FLIPPED: Cell<usize> = const { Cell::new(0) };
+        pub(super) static UNDONE: Cell<usize> = const { Cell::new(0) };
+    }
+
+    /// `items` inserted in one call on `threads`, checked valid.
+    fn built<S: OrbitSpace<N>, const N: usize>(
+        space: &S,
+        items: &[super::Item<S::Point>],
+        threads: Option<usize>,
+    ) -> Engine<S, N> {
+        let mut e = Engine::new(space.clone());
+        e.set_threads(threads);
+        let (log, flow) = e.insert_parallel(items, |_| std::ops::ControlFlow::Continue(()));
+        assert!(flow.is_continue());
+        assert_eq!(log.events.len(), items.len());
+        e.end_batch();
+        assert!(e.is_valid().is_ok(), "{threads:?} threads");
+        e
+    }
+
+    #[test]
+    fn chunks_flip_undo_at_their_borders_and_store_the_same_on_any_thread_count() {
+        // one wave of 28 000 points into the first 2048: dense, so the chunks' flips meet
+        // each other's cells (and undo) thousands of times
+        let mut r = SplitMix::new(23);
+        let space = FlatTorus2::cuboid([1.0, 0.8]).unwrap();
+        let mut items: Vec<super::Item<[f64; 2]>> = (0..30_000u32)
+            .map(|k| {
+                let p = [r.unit(), 0.8 * r.unit()];
+                (k, p, 0.0, space.spatial_key(&p))
+            })
+            .collect();
+        items[..2048].sort_by_key(|it| it.3);
+        items[2048..].sort_by_key(|it| it.3);
+        let build = |threads| built(&space, &items, threads);
+        let triangles = |e: &Engine<FlatTorus2, 3>| -> BTreeSet<[u32; 3]> {
+            // (by input tag: the parallel build numbers vertices in curve order)
+            e.tds
+                .ids()
+                .map(|c| {
+                    let cell = e.tds.cell(c);
+                    let mut t = cell
+                        .v
+                        .map(|v| e.points[v.index()])
+                        .map(|p| items.iter().position(|it| it.1 == p).unwrap() as u32);
+                    t.sort_unstable();
+                    t
+                })
+                .collect()
+        };
+        let alone = build(None);
+        // (one thread runs the chunks on this one)
+        let (flipped, undone) = (FLIPPED.get(), UNDONE.get());
+        let one = build(Some(1));
+        assert!(FLIPPED.get() >= flipped + 20_000, "the chunks flip");
+        assert!(UNDONE.get() >= undone + 100, "and undo at their borders");
+        assert_eq!(one.tds.len(), 2 * 30_000);
+        assert_eq!(triangles(&one), triangles(&alone));
+        for threads in [2, 3] {
+            assert!(
+                build(Some(threads)).tds.cells == one.tds.cells,
+                "{threads} threads"
+            );
+        }
+    }
 
     #[test]
     fn a_wave_needs_threads_a_guaranteed_quotient_and_a_32nd_of_the_points() {
@@ -1277,16 +1556,7 @@ mod tests {
             it.3 = space.spatial_key(&it.1);
         }
         items.sort_by_key(|it| it.3);
-        let build = |threads: Option<usize>| {
-            let mut e = Engine::new(space.clone());
-            e.set_threads(threads);
-            let (log, flow) = e.insert_parallel(&items, |_| std::ops::ControlFlow::Continue(()));
-            assert!(flow.is_continue());
-            assert_eq!(log.events.len(), items.len());
-            e.end_batch();
-            assert!(e.is_valid().is_ok(), "{threads:?} threads");
-            e
-        };
+        let build = |threads| built(&space, &items, threads);
         let alone = build(None);
         let one = build(Some(1));
         assert_eq!(one.points.len(), 30_000);

@@ -174,6 +174,17 @@ impl<O: Packing, const N: usize> Stored<O, N> {
         })
     }
 
+    /// Overwrites the cell with `cell`, its stamp kept; false, with nothing written, when
+    /// an element does not fit in a slot.
+    #[inline(always)]
+    pub fn set(&mut self, cell: &Cell<O, N>) -> bool {
+        let Some(slots) = O::pack_all(cell.off) else {
+            return false;
+        };
+        (self.v, self.n, self.slots) = (cell.v, cell.n, slots);
+        true
+    }
+
     /// The elements of the slots (those of the cell while the store is packed).
     #[inline(always)]
     pub fn packed_offsets(&self) -> [O; N] {

@@ -477,15 +477,11 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     ) -> Result<bool> {
         let space = self.space().clone();
         let key = |k: u32| space.spatial_key(&points[k as usize]);
-        // one at a time in 2D, rounds that grow eightfold (the last holds seven eighths of
-        // the points) keep consecutive points in the cells just made: 8 % off a build of
-        // 10⁶ points in a square (none in a cube or on the sphere; BENCHMARKS.md); the
-        // parallel insertion cuts its waves from doubling rounds
-        let growth = if D == 2 && self.engine.threads().is_none() {
-            3
-        } else {
-            1
-        };
+        // in 2D, rounds that grow eightfold (the last holds seven eighths of the points)
+        // keep consecutive points in the cells just made: 8 % off a build of 10⁶ points in
+        // a square one at a time (none in a cube or on the sphere; BENCHMARKS.md), and the
+        // parallel insertion's chunks, which flip there too, take a round as one wave
+        let growth = if D == 2 { 3 } else { 1 };
         let order = seed.map(|seed| Brio::new(seed, growth));
         let mut done = 0;
         let mut leaving = Leaving::new(dummies, points.len());
