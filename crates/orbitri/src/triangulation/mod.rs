@@ -479,9 +479,14 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         let key = |k: u32| space.spatial_key(&points[k as usize]);
         // in 2D, rounds that grow eightfold (the last holds seven eighths of the points)
         // keep consecutive points in the cells just made: 8 % off a build of 10⁶ points in
-        // a square one at a time (none in a cube or on the sphere; BENCHMARKS.md), and the
-        // parallel insertion's chunks, which flip there too, take a round as one wave
-        let growth = if D == 2 { 3 } else { 1 };
+        // a square one at a time (none in a cube or on the sphere; BENCHMARKS.md), and a
+        // fifth off two threads where the parallel chunks flip too (orientable spaces),
+        // which take a round as one wave; elsewhere those waves double
+        let growth = if D == 2 && (self.engine.threads().is_none() || !S::MAY_REVERSE) {
+            3
+        } else {
+            1
+        };
         let order = seed.map(|seed| Brio::new(seed, growth));
         let mut done = 0;
         let mut leaving = Leaving::new(dummies, points.len());
