@@ -2,10 +2,10 @@
 //!
 //! The points arrive in BRIO + Hilbert order. After a short sequential start they go in
 //! waves, each of the next as many points as there are (so that a wave at most doubles the
-//! triangulation), or where the chunks flip (below) the rest of the call (a BRIO round,
-//! eightfold in 2D: consecutive points then land in the cells just made, which halved the
-//! chunks' cost a point); when fewer than a 32nd of the points are left in the call, they
-//! go one at a time. A wave is sorted along the Hilbert curve and cut into
+//! triangulation), or where the chunks flip (below) up to eight times as many (a whole
+//! BRIO round, eightfold in 2D: consecutive points then land in the cells just made, which
+//! halved the chunks' cost a point); when fewer than a 32nd of the points are left in the
+//! call, they go one at a time. A wave is sorted along the Hilbert curve and cut into
 //! [`CHUNKS`] chunks of consecutive points, and each chunk **owns** the cells of its stretch
 //! of the curve: a cell belongs to the chunk whose range holds the spatial key of its
 //! vertex 0, and a new cell to the chunk that made it. A chunk inserts its points one after
@@ -14,11 +14,12 @@
 //! pass), but only where it owns everything it reads or writes: the walk, the conflict
 //! region and the cells across its boundary. Where the sequential code splits and flips
 //! ([`Engine::flips`]: the flat 2D tori), a chunk does too, for a point strictly inside a
-//! triangle: every cell it flips and every cell it relinks must be its own, and its writes
-//! are journaled and undone when a flip meets another chunk's cell. A point that needs
-//! another chunk's cell, or whose 3D star the ridge table refuses, is deferred. The chunks run on the threads in any order and at once, with no lock: a cell
-//! next to a chunk's own cell cannot change while it is, since changing it would write the
-//! chunk's cell.
+//! triangle: every cell it flips, and every cell next to one it changes, must be its own,
+//! and its writes are journaled and undone when a flip meets another chunk's cell. A point
+//! that needs another chunk's cell, or whose 3D star the ridge table refuses, is deferred.
+//! The chunks run on the threads in any order and at once, with no lock: a cell next to a
+//! chunk's own cell cannot change while it is, since a chunk changes only cells whose
+//! neighbours are all its own.
 //!
 //! The deferred points lie on the chunks' borders (a fifth of the last wave of 10⁶ uniform
 //! points in a cube). Each remembers the chunk whose cell stopped it; those stopped on the
@@ -125,7 +126,8 @@ enum Found {
     Hidden,
     /// Its insertion would hide vertices: the sequential code inserts it after the wave.
     Alone,
-    /// It needs a cell the chunk does not own.
+    /// It needs a cell the chunk does not own, or the chunk's slots or marks ran out, or
+    /// a new cell's elements do not pack (2D flips).
     Foreign,
     /// Its conflict region is collected, and the chunk owns it.
     Region,
@@ -600,11 +602,8 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             }
             if self.wave_ready(items.len() - k) {
                 // (where the chunks flip, a whole round: see the module's comment)
-                let m = if self.flips() {
-                    items.len() - k
-                } else {
-                    (items.len() - k).min(self.points.len())
-                };
+                let grow = if self.flips() { 8 } else { 1 };
+                let m = (items.len() - k).min(grow * self.points.len());
                 self.wave(items, k..k + m, &mut shared, &mut log);
                 k += m;
                 continue;
@@ -994,7 +993,8 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
 
     /// The probe of a chunk's next point: locates it (walking from the chunk's last
     /// insertion) and collects its conflict region, reading only cells the chunk owns and
-    /// their neighbours.
+    /// their neighbours; in 2D strictly inside a triangle where [`Engine::flips`], inserts
+    /// it by flips instead ([`Self::split_in_chunk`]).
     fn probe(
         &self,
         (_, p, _, key): Item<S::Point>,
@@ -1082,7 +1082,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             (own.owner(st) != me).then(|| own.chunk(st))
         };
         let old = self.tds.cell(c0);
-        // (the first neighbour is tested by the first flip; the other two get new links)
+        // (every cell next to one the chunk changes must be its own: here all three)
         if let Some(k) = old.n.iter().find_map(|&n| foreign(n)) {
             ch.foreign = Some(k);
             return Found::Foreign;
@@ -1117,7 +1117,9 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 };
                 let ec = self.tds.cell(e);
                 let ([nt, ne], [(first, o1), (second, o2)]) = flipped(&tc, (e, &ec, j), far, t);
-                if let Some(k) = foreign(o1).or_else(|| foreign(o2)) {
+                // (the cells across `e`'s other edges: `t`'s other neighbours hold `x`, and
+                // are the chunk's, as the new cells and those it flipped)
+                if let Some(k) = foreign(o1).or_else(|| foreign(ec.n[(j + 2) % 3])) {
                     stopped = Some(Some(k));
                     break;
                 }
@@ -1426,7 +1428,7 @@ mod tests {
     use crate::sort::SplitMix;
     use crate::space::{FlatTorus2, FlatTorus3, OrbitSpace};
     use std::cell::Cell;
-    use std::collections::BTreeSet;
+    use std::collections::{BTreeSet, HashMap};
 
     thread_local! {
         /// Points the 2D chunks that ran on this thread inserted by flips, and flips they
@@ -1453,8 +1455,8 @@ mod tests {
 
     #[test]
     fn chunks_flip_undo_at_their_borders_and_store_the_same_on_any_thread_count() {
-        // one wave of 28 000 points into the first 2048: dense, so the chunks' flips meet
-        // each other's cells (and undo) thousands of times
+        // 28 000 points into the first 2048, in two waves (16 384, then the rest): dense,
+        // so the chunks' flips meet each other's cells (and undo) thousands of times
         let mut r = SplitMix::new(23);
         let space = FlatTorus2::cuboid([1.0, 0.8]).unwrap();
         let mut items: Vec<super::Item<[f64; 2]>> = (0..30_000u32)
@@ -1466,8 +1468,12 @@ mod tests {
         items[..2048].sort_by_key(|it| it.3);
         items[2048..].sort_by_key(|it| it.3);
         let build = |threads| built(&space, &items, threads);
+        // (by input tag: the parallel build numbers vertices in curve order)
+        let tag: HashMap<[u64; 2], u32> = items
+            .iter()
+            .map(|it| (it.1.map(f64::to_bits), it.0))
+            .collect();
         let triangles = |e: &Engine<FlatTorus2, 3>| -> BTreeSet<[u32; 3]> {
-            // (by input tag: the parallel build numbers vertices in curve order)
             e.tds
                 .ids()
                 .map(|c| {
@@ -1475,7 +1481,7 @@ mod tests {
                     let mut t = cell
                         .v
                         .map(|v| e.points[v.index()])
-                        .map(|p| items.iter().position(|it| it.1 == p).unwrap() as u32);
+                        .map(|p| tag[&p.map(f64::to_bits)]);
                     t.sort_unstable();
                     t
                 })
