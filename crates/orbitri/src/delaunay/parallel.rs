@@ -234,13 +234,6 @@ impl<O: Packing, const N: usize> Chunk<O, N> {
         }
     }
 
-    /// A slot for a new cell: a spare one, else a fresh one (the caller checked that there
-    /// is one).
-    #[inline(always)]
-    fn take_slot(&mut self) -> CellId {
-        take_slot(&mut self.spare, &mut self.fresh)
-    }
-
     /// Writes `cell` into slot `c` of the pass's store, stamped `stamp` (or keeping its
     /// stamp), journaled; false, with nothing written, when its elements do not pack.
     ///
@@ -1089,29 +1082,27 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         }
         ch.journal.clear();
         ch.moved.clear();
-        let (b, d) = (ch.take_slot(), ch.take_slot());
-        let mut stopped = None;
-        for (id, t) in [c0, b, d].into_iter().zip(split(&old, x, q0, [c0, b, d])) {
-            let stamp = (id != c0).then_some(stamp);
-            if !ch.rewrite(cells, id, &self.canonical_triangle(t), stamp) {
-                stopped = Some(None);
-                break;
+        let (b, d) = (
+            take_slot(&mut ch.spare, &mut ch.fresh),
+            take_slot(&mut ch.spare, &mut ch.fresh),
+        );
+        // (`Err`: stopped, by the chunk that owns a cell it needs if any)
+        let mut flips = || -> Result<(), Option<u32>> {
+            for (id, t) in [c0, b, d].into_iter().zip(split(&old, x, q0, [c0, b, d])) {
+                let stamp = (id != c0).then_some(stamp);
+                if !ch.rewrite(cells, id, &self.canonical_triangle(t), stamp) {
+                    return Err(None);
+                }
             }
-        }
-        if stopped.is_none() {
             ch.relink(cells, (b, 0), old.n[1], c0);
             ch.relink(cells, (d, 0), old.n[2], c0);
             ch.move_vertex(vcell, old.v[0], c0, b);
-            let mut edges = std::mem::take(&mut ch.edges);
-            edges.clear();
-            edges.extend([c0, b, d]);
-            while let Some(t) = edges.pop() {
+            ch.edges.clear();
+            ch.edges.extend([c0, b, d]);
+            while let Some(t) = ch.edges.pop() {
                 let tc = self.tds.cell(t);
                 let e = tc.n[0];
-                if let Some(k) = foreign(e) {
-                    stopped = Some(Some(k));
-                    break;
-                }
+                foreign(e).map_or(Ok(()), |k| Err(Some(k)))?;
                 let Some((far, j)) = self.far_in_conflict(t, &tc, e, p) else {
                     continue;
                 };
@@ -1119,25 +1110,22 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 let ([nt, ne], [(first, o1), (second, o2)]) = flipped(&tc, (e, &ec, j), far, t);
                 // (the cells across `e`'s other edges: `t`'s other neighbours hold `x`, and
                 // are the chunk's, as the new cells and those it flipped)
-                if let Some(k) = foreign(o1).or_else(|| foreign(ec.n[(j + 2) % 3])) {
-                    stopped = Some(Some(k));
-                    break;
-                }
+                let across = foreign(o1).or_else(|| foreign(ec.n[(j + 2) % 3]));
+                across.map_or(Ok(()), |k| Err(Some(k)))?;
                 if !ch.rewrite(cells, t, &self.canonical_triangle(nt), None)
                     || !ch.rewrite(cells, e, &self.canonical_triangle(ne), None)
                 {
-                    stopped = Some(None);
-                    break;
+                    return Err(None);
                 }
                 ch.relink(cells, (t, 0), o1, e);
                 ch.relink(cells, (e, 1), o2, t);
                 ch.move_vertex(vcell, first, e, t);
                 ch.move_vertex(vcell, second, t, e);
-                edges.extend([t, e]);
+                ch.edges.extend([t, e]);
             }
-            ch.edges = edges;
-        }
-        if let Some(k) = stopped {
+            Ok(())
+        };
+        if let Err(k) = flips() {
             ch.undo(cells, vcell, [b, d]);
             #[cfg(test)]
             tests::UNDONE.with(|n| n.set(n.get() + 1));

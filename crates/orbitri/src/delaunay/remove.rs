@@ -119,9 +119,10 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// cells break it, each is checked instead to keep the covering simplicial, and the
     /// points left must then reach the quotient ([`Self::try_one_sheet`]). Else, or when
     /// one cannot leave there after all, the points go on in the covering of level 0 (from
-    /// the quotient as it was), where every removal goes in place. Then the last point takes each one's id, largest first: the
-    /// other points keep theirs, so only the cells around the `k` moved points are
-    /// rewritten, where renumbering all in order ([`Self::compact`]) rewrites every cell.
+    /// the quotient as it was), where every removal goes in place. Then the last point
+    /// takes each one's id, largest first: the other points keep theirs, so only the cells
+    /// around the `k` moved points are rewritten, where renumbering all in order
+    /// ([`Self::compact`]) rewrites every cell.
     /// Returns, for each id `d < k`, the first id of the point last moved into it (a point
     /// moves again when fewer than `k` others remain; its new id is the smallest that lists
     /// it), or `None` when a round removes none in the quotient of another space (the
