@@ -29,7 +29,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// `q.1` in `c`'s frame (`qoff`: its element as inserted), by splitting `c` and
     /// flipping (see the module). `x` is at slot 0 of `c` afterwards, which is the next
     /// walk's start.
-    pub(super) fn split_and_flip(
+    pub(super) fn insert_by_flips(
         &mut self,
         c: CellId,
         (p, qo): LiftedOf<S, N>,
@@ -39,33 +39,8 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         let old = self.tds.cell(c);
         // (two more slots; guaranteed, so no criterion bookkeeping)
         let (b, d) = (self.tds.create(old), self.tds.create(old));
-        let [tc, tb, td] = split(&old, x, qo, [c, b, d]);
-        self.rewrite(c, tc);
-        self.rewrite(b, tb);
-        self.rewrite(d, td);
-        self.relink(b, 0, old.n[1], c);
-        self.relink(d, 0, old.n[2], c);
-        self.vcell[old.v[0].index()] = b;
-        // (the cells whose edge opposite `x` is still to test)
         let mut edges = std::mem::take(&mut self.scratch.created);
-        edges.clear();
-        edges.extend([c, b, d]);
-        while let Some(t) = edges.pop() {
-            let tc = self.tds.cell(t);
-            let e = tc.n[0];
-            let Some((far, j)) = self.far_in_conflict(t, &tc, e, p) else {
-                continue;
-            };
-            let ec = self.tds.cell(e);
-            let ([nt, ne], [(first, o1), (second, o2)]) = flipped(&tc, (e, &ec, j), far, t);
-            self.rewrite(t, nt);
-            self.rewrite(e, ne);
-            self.relink(t, 0, o1, e);
-            self.relink(e, 1, o2, t);
-            self.vcell[first.index()] = t;
-            self.vcell[second.index()] = e;
-            edges.extend([t, e]);
-        }
+        let Ok(()) = split_and_flip(self, &old, [c, b, d], (p, qo), x, &mut edges);
         self.scratch.created = edges;
         self.vcell[x.index()] = c;
         self.hint = c;
@@ -76,7 +51,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     /// the vertex of its neighbour `e` across from the new vertex, and that vertex's slot,
     /// when `e` is in conflict with the new point `p`: the edge between them is to flip.
     #[inline(always)]
-    pub(super) fn far_in_conflict(
+    fn far_in_conflict(
         &self,
         t: CellId,
         tc: &Cell<S::Elem, N>,
@@ -102,20 +77,104 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         cell.n = tri(n);
         cell
     }
+}
 
-    /// Overwrites live cell `c` with triangle `t` (canonical; the stamp kept).
+/// Where the flips of one insertion read and write: the engine's own store (one at a time),
+/// or a parallel chunk's share of it, which checks that it owns each cell it changes and
+/// journals each write.
+pub(super) trait Flipper<S: OrbitSpace<N>, const N: usize> {
+    /// Why the flips stopped halfway (never, one at a time).
+    type Stop;
+    /// The triangulation read.
+    fn engine(&self) -> &Engine<S, N>;
+    /// Ok when cell `c`, next to a cell that changes, may change too.
+    fn may_change(&self, c: CellId) -> Result<(), Self::Stop>;
+    /// Overwrites cell `c`, a new slot when `new`, with triangle `t`.
+    fn rewrite(&mut self, c: CellId, t: Triangle<S::Elem>, new: bool) -> Result<(), Self::Stop>;
+    /// Links facet `i` of `a` (written already) with the facet of `d` that was linked to
+    /// `old`.
+    fn relink(&mut self, a: (CellId, usize), d: CellId, old: CellId);
+    /// Vertex `v` left cell `from` for cell `to`.
+    fn move_vertex(&mut self, v: VertexId, from: CellId, to: CellId);
+}
+
+impl<S: OrbitSpace<N>, const N: usize> Flipper<S, N> for Engine<S, N> {
+    type Stop = std::convert::Infallible;
+
     #[inline(always)]
-    fn rewrite(&mut self, c: CellId, t: Triangle<S::Elem>) {
-        let cell = self.canonical_triangle(t);
-        self.tds.put(c, cell);
+    fn engine(&self) -> &Engine<S, N> {
+        self
     }
 
-    /// Links facet `i` of `a` with the facet of `d` that was linked to `old`.
     #[inline(always)]
-    fn relink(&mut self, a: CellId, i: usize, d: CellId, old: CellId) {
+    fn may_change(&self, _: CellId) -> Result<(), Self::Stop> {
+        Ok(())
+    }
+
+    #[inline(always)]
+    fn rewrite(&mut self, c: CellId, t: Triangle<S::Elem>, _: bool) -> Result<(), Self::Stop> {
+        let cell = self.canonical_triangle(t);
+        self.tds.put(c, cell);
+        Ok(())
+    }
+
+    #[inline(always)]
+    fn relink(&mut self, (a, i): (CellId, usize), d: CellId, old: CellId) {
         let j = self.mirror_of(d, old);
         self.link(a, i, d, j);
     }
+
+    #[inline(always)]
+    fn move_vertex(&mut self, v: VertexId, _: CellId, to: CellId) {
+        self.vcell[v.index()] = to;
+    }
+}
+
+/// Splits cell `c` (contents `old`) into the slots `[c, b, d]` at vertex `x`, the point
+/// `p` lifted by `qo` in `c`'s frame strictly inside it, then flips each edge opposite `x`
+/// while the triangle across is in conflict with `p` (see the module); `x` is at slot 0 of
+/// `c`, `b` and `d`, and of every cell flipped. `edges` holds the cells whose edge opposite
+/// `x` is still to test (kept apart from `f`, so that its length stays in a register).
+#[inline(always)]
+pub(super) fn split_and_flip<S: OrbitSpace<N>, const N: usize, F: Flipper<S, N>>(
+    f: &mut F,
+    old: &Cell<S::Elem, N>,
+    [c, b, d]: [CellId; 3],
+    (p, qo): LiftedOf<S, N>,
+    x: VertexId,
+    edges: &mut Vec<CellId>,
+) -> Result<(), F::Stop> {
+    let [tc, tb, td] = split(old, x, qo, [c, b, d]);
+    f.rewrite(c, tc, false)?;
+    f.rewrite(b, tb, true)?;
+    f.rewrite(d, td, true)?;
+    f.relink((b, 0), old.n[1], c);
+    f.relink((d, 0), old.n[2], c);
+    f.move_vertex(old.v[0], c, b);
+    edges.clear();
+    edges.extend([c, b, d]);
+    while let Some(t) = edges.pop() {
+        let tc = f.engine().tds.cell(t);
+        let e = tc.n[0];
+        f.may_change(e)?;
+        let Some((far, j)) = f.engine().far_in_conflict(t, &tc, e, p) else {
+            continue;
+        };
+        let ec = f.engine().tds.cell(e);
+        let ([nt, ne], [(first, o1), (second, o2)]) = flipped(&tc, (e, &ec, j), far, t);
+        // (the cells across `e`'s other edges: `t`'s other neighbours hold `x`, and have
+        // changed already, as `t` and `e`)
+        f.may_change(o1)?;
+        f.may_change(ec.n[(j + 2) % 3])?;
+        f.rewrite(t, nt, false)?;
+        f.rewrite(e, ne, false)?;
+        f.relink((t, 0), o1, e);
+        f.relink((e, 1), o2, t);
+        f.move_vertex(first, e, t);
+        f.move_vertex(second, t, e);
+        edges.extend([t, e]);
+    }
+    Ok(())
 }
 
 /// A triangle as the flips build it: vertices, elements, neighbours.
@@ -124,7 +183,7 @@ pub(super) type Triangle<O> = ([VertexId; 3], [O; 3], [CellId; 3]);
 /// The triangles that splitting cell `old` at vertex `x` (element `qo`) makes, for the
 /// slots `[c, b, d]` (`c` is `old`'s): `x` in place of each vertex in turn, rotated to
 /// slot 0, each linked to the neighbour across its edge and to the other two.
-pub(super) fn split<O: Copy, const N: usize>(
+fn split<O: Copy, const N: usize>(
     old: &Cell<O, N>,
     x: VertexId,
     qo: O,
@@ -150,7 +209,7 @@ pub(super) fn split<O: Copy, const N: usize>(
 /// left `e`, with the outside cell now across from the new vertex in `t` (it was linked to
 /// `e`), and the second end, which left `t`, with the outside cell now at slot 1 of `e`
 /// (it was linked to `t`).
-pub(super) fn flipped<O: Copy, const N: usize>(
+fn flipped<O: Copy, const N: usize>(
     tc: &Cell<O, N>,
     (e, ec, j): (CellId, &Cell<O, N>, usize),
     far: O,

@@ -566,7 +566,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         let (c, qo, strict) = self.locate_lifted(q, from);
         if strict && self.flips() {
             // (strictly inside a triangle: no vertex there, no duplicate)
-            self.split_and_flip(c, (q.0, qo), x, q.1);
+            self.insert_by_flips(c, (q.0, qo), x, q.1);
             return Ok(());
         }
         self.conflict_region_at((c, qo), q, x, check_duplicate)?;

@@ -48,7 +48,7 @@ use std::sync::atomic::{AtomicU32, AtomicUsize};
 
 use rayon::prelude::*;
 
-use super::flip::{flipped, split};
+use super::flip::{split_and_flip, Flipper, Triangle};
 use super::insert::{closes, edge_ends, enter, next_edge, slot_in, Frame, Refused};
 use super::ridges::Ridges;
 use super::{Engine, HiddenPoint, Inserted};
@@ -231,61 +231,6 @@ impl<O: Packing, const N: usize> Chunk<O, N> {
             edges: Vec::new(),
             journal: Vec::new(),
             moved: Vec::new(),
-        }
-    }
-
-    /// Writes `cell` into slot `c` of the pass's store, stamped `stamp` (or keeping its
-    /// stamp), journaled; false, with nothing written, when its elements do not pack.
-    ///
-    /// # Safety
-    /// The chunk owns `c` (or it is one of its slots).
-    #[inline(always)]
-    unsafe fn rewrite(
-        &mut self,
-        cells: &SharedCells<O, N>,
-        c: CellId,
-        cell: &Cell<O, N>,
-        stamp: Option<u32>,
-    ) -> bool {
-        let slot = &mut *cells.get(c);
-        let was = *slot;
-        if !slot.set(cell) {
-            return false;
-        }
-        if let Some(s) = stamp {
-            slot.set_stamp(s);
-        }
-        self.journal.push((c, was));
-        true
-    }
-
-    /// Links facet `i` of `a` (written already) with the facet of `d` that was linked to
-    /// `old`, journaled.
-    ///
-    /// # Safety
-    /// The chunk owns `a` and `d`.
-    #[inline(always)]
-    unsafe fn relink(
-        &mut self,
-        cells: &SharedCells<O, N>,
-        (a, i): (CellId, usize),
-        d: CellId,
-        old: CellId,
-    ) {
-        let cell = &mut *cells.get(d);
-        let j = cell.mirror(old).expect("symmetric neighbours");
-        self.journal.push((d, *cell));
-        cell.n[j] = a;
-        (*cells.get(a)).n[i] = d;
-    }
-
-    /// Points vertex `v` at cell `to` if it points at `from`, journaled (`from` is the
-    /// chunk's, so no other chunk moves `v` meanwhile).
-    #[inline(always)]
-    fn move_vertex(&mut self, vcell: &[AtomicU32], v: VertexId, from: CellId, to: CellId) {
-        if vcell[v.index()].load(Relaxed) == from.0 {
-            self.moved.push((v, from.0));
-            vcell[v.index()].store(to.0, Relaxed);
         }
     }
 
@@ -1047,12 +992,12 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     }
 
     /// 2D, where [`Engine::flips`]: inserts `x` at `p`, strictly inside the chunk's cell
-    /// `c0` lifted by `q0`, by splitting it and flipping as [`Engine::split_and_flip`]
-    /// does, reading only cells the chunk owns and the stamps of their neighbours, and
-    /// writing only cells it owns (new ones stamped `stamp`). Each write is journaled and
-    /// all are undone when a flip needs another chunk's cell (`Foreign`, with
-    /// `ch.foreign`), a new triangle's elements do not pack, or the chunk has no two slots
-    /// left (`Foreign`, `ch.full`).
+    /// `c0` lifted by `q0`, by splitting it and flipping as one at a time does
+    /// ([`split_and_flip`] on an [`InChunk`]), reading only cells the chunk owns and the
+    /// stamps of their neighbours, and writing only cells it owns (new ones stamped
+    /// `stamp`). Each write is journaled and all are undone when a flip needs another
+    /// chunk's cell (`Foreign`, with `ch.foreign`), a new triangle's elements do not pack,
+    /// or the chunk has no two slots left (`Foreign`, `ch.full`).
     ///
     /// # Safety
     /// `cells` is the pass's store, in which no other chunk writes the cells this one owns.
@@ -1069,63 +1014,30 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             ch.full = true;
             return Found::Foreign;
         }
-        let me = ch.id;
-        let foreign = |c: CellId| {
-            let st = (*cells.get(c)).stamp();
-            (own.owner(st) != me).then(|| own.chunk(st))
+        let mut f = InChunk {
+            engine: self,
+            ch,
+            own,
+            cells,
+            vcell,
+            stamp,
         };
         let old = self.tds.cell(c0);
         // (every cell next to one the chunk changes must be its own: here all three)
-        if let Some(k) = old.n.iter().find_map(|&n| foreign(n)) {
-            ch.foreign = Some(k);
+        if let Err(k) = old.n.iter().try_for_each(|&n| f.may_change(n)) {
+            f.ch.foreign = k;
             return Found::Foreign;
         }
-        ch.journal.clear();
-        ch.moved.clear();
+        f.ch.journal.clear();
+        f.ch.moved.clear();
         let (b, d) = (
-            take_slot(&mut ch.spare, &mut ch.fresh),
-            take_slot(&mut ch.spare, &mut ch.fresh),
+            take_slot(&mut f.ch.spare, &mut f.ch.fresh),
+            take_slot(&mut f.ch.spare, &mut f.ch.fresh),
         );
-        // (`Err`: stopped, by the chunk that owns a cell it needs if any)
-        let mut flips = || -> Result<(), Option<u32>> {
-            for (id, t) in [c0, b, d].into_iter().zip(split(&old, x, q0, [c0, b, d])) {
-                let stamp = (id != c0).then_some(stamp);
-                if !ch.rewrite(cells, id, &self.canonical_triangle(t), stamp) {
-                    return Err(None);
-                }
-            }
-            ch.relink(cells, (b, 0), old.n[1], c0);
-            ch.relink(cells, (d, 0), old.n[2], c0);
-            ch.move_vertex(vcell, old.v[0], c0, b);
-            ch.edges.clear();
-            ch.edges.extend([c0, b, d]);
-            while let Some(t) = ch.edges.pop() {
-                let tc = self.tds.cell(t);
-                let e = tc.n[0];
-                foreign(e).map_or(Ok(()), |k| Err(Some(k)))?;
-                let Some((far, j)) = self.far_in_conflict(t, &tc, e, p) else {
-                    continue;
-                };
-                let ec = self.tds.cell(e);
-                let ([nt, ne], [(first, o1), (second, o2)]) = flipped(&tc, (e, &ec, j), far, t);
-                // (the cells across `e`'s other edges: `t`'s other neighbours hold `x`, and
-                // are the chunk's, as the new cells and those it flipped)
-                let across = foreign(o1).or_else(|| foreign(ec.n[(j + 2) % 3]));
-                across.map_or(Ok(()), |k| Err(Some(k)))?;
-                if !ch.rewrite(cells, t, &self.canonical_triangle(nt), None)
-                    || !ch.rewrite(cells, e, &self.canonical_triangle(ne), None)
-                {
-                    return Err(None);
-                }
-                ch.relink(cells, (t, 0), o1, e);
-                ch.relink(cells, (e, 1), o2, t);
-                ch.move_vertex(vcell, first, e, t);
-                ch.move_vertex(vcell, second, t, e);
-                ch.edges.extend([t, e]);
-            }
-            Ok(())
-        };
-        if let Err(k) = flips() {
+        let mut edges = std::mem::take(&mut f.ch.edges);
+        let flipped = split_and_flip(&mut f, &old, [c0, b, d], (p, q0), x, &mut edges);
+        ch.edges = edges;
+        if let Err(k) = flipped {
             ch.undo(cells, vcell, [b, d]);
             #[cfg(test)]
             tests::UNDONE.with(|n| n.set(n.get() + 1));
@@ -1384,6 +1296,76 @@ unsafe fn commit<S: OrbitSpace<N>, const N: usize>(
         space.carry(space.identity(), new[0].packed_offsets()[k]),
     ));
     Commit::Starred
+}
+
+/// A chunk's share of the pass's store, as the flips see it ([`Engine::split_in_chunk`]):
+/// only cells it owns may change, new cells are stamped `stamp`, and each write is
+/// journaled for [`Chunk::undo`]. Stops with the chunk that owns a cell it needs, if any.
+struct InChunk<'a, S: OrbitSpace<N>, const N: usize> {
+    engine: &'a Engine<S, N>,
+    ch: &'a mut Chunk<S::Elem, N>,
+    own: &'a Ownership,
+    /// The pass's store, in which no other chunk writes the cells `ch` owns (the
+    /// promise of `split_in_chunk`'s caller, the only place one is made).
+    cells: &'a SharedCells<S::Elem, N>,
+    vcell: &'a [AtomicU32],
+    stamp: u32,
+}
+
+impl<S: OrbitSpace<N>, const N: usize> Flipper<S, N> for InChunk<'_, S, N> {
+    type Stop = Option<u32>;
+
+    #[inline(always)]
+    fn engine(&self) -> &Engine<S, N> {
+        self.engine
+    }
+
+    #[inline(always)]
+    fn may_change(&self, c: CellId) -> Result<(), Self::Stop> {
+        // SAFETY: a stamp is read, of a cell next to the chunk's own (see `cells`)
+        let st = unsafe { (*self.cells.get(c)).stamp() };
+        match self.own.owner(st) == self.ch.id {
+            true => Ok(()),
+            false => Err(Some(self.own.chunk(st))),
+        }
+    }
+
+    #[inline(always)]
+    fn rewrite(&mut self, c: CellId, t: Triangle<S::Elem>, new: bool) -> Result<(), Self::Stop> {
+        let cell = self.engine.canonical_triangle(t);
+        // SAFETY: `c` is the chunk's, checked or one of its slots (see `cells`)
+        let slot = unsafe { &mut *self.cells.get(c) };
+        let was = *slot;
+        if !slot.set(&cell) {
+            return Err(None);
+        }
+        if new {
+            slot.set_stamp(self.stamp);
+        }
+        self.ch.journal.push((c, was));
+        Ok(())
+    }
+
+    #[inline(always)]
+    fn relink(&mut self, (a, i): (CellId, usize), d: CellId, old: CellId) {
+        // SAFETY: `a` and `d` are the chunk's (see `cells`)
+        let cell = unsafe { &mut *self.cells.get(d) };
+        let j = cell.mirror(old).expect("symmetric neighbours");
+        self.ch.journal.push((d, *cell));
+        cell.n[j] = a;
+        unsafe { (*self.cells.get(a)).n[i] = d };
+    }
+
+    /// Points `v` at `to` only if it points at `from`: `from` is the chunk's, so no other
+    /// chunk moves `v` meanwhile, and the outcome does not depend on timing.
+    #[inline(always)]
+    fn move_vertex(&mut self, v: VertexId, from: CellId, to: CellId) {
+        let cell = &self.vcell[v.index()];
+        if cell.load(Relaxed) == from.0 {
+            self.ch.moved.push((v, from.0));
+            cell.store(to.0, Relaxed);
+        }
+    }
 }
 
 /// A slot for a new cell: a spare one, else a fresh one (the caller checked that there
