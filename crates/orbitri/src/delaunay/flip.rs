@@ -81,15 +81,17 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
 
 /// Where the flips of one insertion read and write: the engine's own store (one at a time),
 /// or a parallel chunk's share of it, which checks that it owns each cell it changes and
-/// journals each write.
+/// journals each write. A chunk's soundness rests on [`split_and_flip`]'s contract.
 pub(super) trait Flipper<S: OrbitSpace<N>, const N: usize> {
     /// Why the flips stopped halfway (never, one at a time).
     type Stop;
     /// The triangulation read.
     fn engine(&self) -> &Engine<S, N>;
-    /// Ok when cell `c`, next to a cell that changes, may change too.
+    /// Ok when the flips may change cells next to `c`, and `c` itself (a chunk: it owns
+    /// `c`).
     fn may_change(&self, c: CellId) -> Result<(), Self::Stop>;
-    /// Overwrites cell `c`, a new slot when `new`, with triangle `t`.
+    /// Overwrites cell `c` with triangle `t` in canonical form: a new slot when `new` (a
+    /// chunk stamps it), else its stamp kept.
     fn rewrite(&mut self, c: CellId, t: Triangle<S::Elem>, new: bool) -> Result<(), Self::Stop>;
     /// Links facet `i` of `a` (written already) with the facet of `d` that was linked to
     /// `old`.
@@ -135,6 +137,11 @@ impl<S: OrbitSpace<N>, const N: usize> Flipper<S, N> for Engine<S, N> {
 /// while the triangle across is in conflict with `p` (see the module); `x` is at slot 0 of
 /// `c`, `b` and `d`, and of every cell flipped. `edges` holds the cells whose edge opposite
 /// `x` is still to test (kept apart from `f`, so that its length stays in a register).
+///
+/// Its contract, on which a chunk's unsafe writes rely ([`Flipper`]): it reads and writes
+/// only `c`, `b`, `d`, cells it wrote already and cells that [`Flipper::may_change`]
+/// accepted first (the caller checks `c`'s neighbours), and reads other cells' stamps only
+/// through `may_change`.
 #[inline(always)]
 pub(super) fn split_and_flip<S: OrbitSpace<N>, const N: usize, F: Flipper<S, N>>(
     f: &mut F,
@@ -162,8 +169,8 @@ pub(super) fn split_and_flip<S: OrbitSpace<N>, const N: usize, F: Flipper<S, N>>
         };
         let ec = f.engine().tds.cell(e);
         let ([nt, ne], [(first, o1), (second, o2)]) = flipped(&tc, (e, &ec, j), far, t);
-        // (the cells across `e`'s other edges: `t`'s other neighbours hold `x`, and have
-        // changed already, as `t` and `e`)
+        // (`e`'s other neighbours, `o1` and the one below; `t`'s other neighbours hold `x`, so
+        // this insertion made them and, in a chunk, they are its own)
         f.may_change(o1)?;
         f.may_change(ec.n[(j + 2) % 3])?;
         f.rewrite(t, nt, false)?;

@@ -1306,7 +1306,9 @@ struct InChunk<'a, S: OrbitSpace<N>, const N: usize> {
     ch: &'a mut Chunk<S::Elem, N>,
     own: &'a Ownership,
     /// The pass's store, in which no other chunk writes the cells `ch` owns (the
-    /// promise of `split_in_chunk`'s caller, the only place one is made).
+    /// promise of `split_in_chunk`'s caller, the only place one is made). Its writes are
+    /// safe by [`split_and_flip`]'s contract: to cells checked by `may_change` first, or
+    /// to the chunk's slots.
     cells: &'a SharedCells<S::Elem, N>,
     vcell: &'a [AtomicU32],
     stamp: u32,
@@ -1322,18 +1324,21 @@ impl<S: OrbitSpace<N>, const N: usize> Flipper<S, N> for InChunk<'_, S, N> {
 
     #[inline(always)]
     fn may_change(&self, c: CellId) -> Result<(), Self::Stop> {
-        // SAFETY: a stamp is read, of a cell next to the chunk's own (see `cells`)
+        // SAFETY: a stamp is read, of a cell next to the chunk's own, which cannot change
+        // while it is (see the module's comment)
         let st = unsafe { (*self.cells.get(c)).stamp() };
-        match self.own.owner(st) == self.ch.id {
-            true => Ok(()),
-            false => Err(Some(self.own.chunk(st))),
+        if self.own.owner(st) == self.ch.id {
+            Ok(())
+        } else {
+            Err(Some(self.own.chunk(st)))
         }
     }
 
     #[inline(always)]
     fn rewrite(&mut self, c: CellId, t: Triangle<S::Elem>, new: bool) -> Result<(), Self::Stop> {
         let cell = self.engine.canonical_triangle(t);
-        // SAFETY: `c` is the chunk's, checked or one of its slots (see `cells`)
+        // SAFETY: `c` is the chunk's, checked or one of its slots (see `cells`), and the
+        // reference is the only one to it
         let slot = unsafe { &mut *self.cells.get(c) };
         let was = *slot;
         if !slot.set(&cell) {
@@ -1348,11 +1353,12 @@ impl<S: OrbitSpace<N>, const N: usize> Flipper<S, N> for InChunk<'_, S, N> {
 
     #[inline(always)]
     fn relink(&mut self, (a, i): (CellId, usize), d: CellId, old: CellId) {
-        // SAFETY: `a` and `d` are the chunk's (see `cells`)
+        // SAFETY: `d` is the chunk's (see `cells`); the reference ends before `a`'s write
         let cell = unsafe { &mut *self.cells.get(d) };
         let j = cell.mirror(old).expect("symmetric neighbours");
         self.ch.journal.push((d, *cell));
         cell.n[j] = a;
+        // SAFETY: `a` is the chunk's, written already (see `cells`)
         unsafe { (*self.cells.get(a)).n[i] = d };
     }
 
