@@ -12,6 +12,10 @@
 
 use std::fmt;
 use std::hash::{Hash, Hasher};
+use std::sync::atomic::AtomicU32;
+use std::sync::atomic::Ordering::Relaxed;
+
+use rayon::prelude::*;
 
 macro_rules! id {
     ($(#[$doc:meta])* $name:ident) => {
@@ -35,6 +39,16 @@ macro_rules! id {
             #[inline(always)]
             pub const fn index(self) -> usize {
                 self.0 as usize
+            }
+
+            /// A store of ids as atomics, for threads that write it at once (each its
+            /// own entries, or racing to a result that does not depend on the order).
+            pub fn atomics(ids: &mut [Self]) -> &[AtomicU32] {
+                // SAFETY: `#[repr(transparent)]` over `u32`, which `AtomicU32` has the
+                // size and bit validity of, and ids are 4-aligned as `u32`s are here
+                // (checked below); the mutable borrow is exclusive while the atomics live.
+                const { assert!(std::mem::align_of::<u32>() == std::mem::align_of::<AtomicU32>()) };
+                unsafe { std::slice::from_raw_parts(ids.as_mut_ptr().cast(), ids.len()) }
             }
         }
 
@@ -96,6 +110,26 @@ id!(
     /// given; duplicates are listed by the id of their first occurrence.
     InputId
 );
+
+/// Records that inputs `input(n)`, `n < count`, became the points `point_input.len() + n`
+/// (a bulk insertion whose points were all new): each names the other, in `input_point`
+/// and `point_input`. On rayon's pool: the inputs come in a random order, and one by one
+/// their entries cost 16 ms of a build of 10⁶ points in a square.
+pub(crate) fn record_new_inputs(
+    (point_input, input_point): (&mut Vec<InputId>, &mut [PointId]),
+    count: usize,
+    input: impl Fn(usize) -> InputId + Sync,
+) {
+    let first = point_input.len();
+    point_input.par_extend((0..count).into_par_iter().map(&input));
+    let slots = PointId::atomics(input_point);
+    (0..count)
+        .into_par_iter()
+        .with_min_len(1 << 12)
+        .for_each(|n| {
+            slots[input(n).index()].store((first + n) as u32, Relaxed);
+        });
+}
 
 #[cfg(test)]
 mod tests {

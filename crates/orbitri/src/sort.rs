@@ -224,13 +224,17 @@ pub fn brio_rounds(n: usize, Brio { seed, growth }: Brio) -> (Vec<u32>, Vec<usiz
 
 /// Feeds the BRIO rounds of `n` items ([`brio_rounds`] by `order`) to `consume` in order,
 /// each as `(key, index)` pairs sorted by `key` and made ready by `prepare` (it gathers the
-/// items) on a helper thread while the round before it is consumed: the insertion order,
-/// a tenth of a build when done up front, hides behind the insertion, which takes ten
-/// times longer a point. Without an order, all items in their order as one round, unsorted.
-/// Stops at `consume`'s first error. (Below 2¹⁴ items, all on the caller's thread.)
+/// items). With `ahead`, each round is made ready on a helper thread while the round
+/// before it is consumed: the insertion order, a tenth of a build when done up front,
+/// hides behind an insertion one point at a time, which takes ten times longer a point.
+/// Without, on the caller's thread, the keys and the sort on rayon's pool: for a parallel
+/// insertion, whose threads the helper would slow (it took a tenth of the time of the
+/// chunks it ran beside, on the sphere with two threads). Without an order, all items in
+/// their order as one round, unsorted. Stops at `consume`'s first error. (Below 2¹⁴
+/// items, all on the caller's thread.)
 pub fn in_rounds<T: Send, E>(
     n: usize,
-    order: Option<Brio>,
+    (order, ahead): (Option<Brio>, bool),
     key: impl Fn(u32) -> u64 + Sync,
     prepare: impl Fn(Vec<(u64, u32)>) -> T + Sync,
     mut consume: impl FnMut(T) -> Result<(), E>,
@@ -239,15 +243,22 @@ pub fn in_rounds<T: Send, E>(
         Some(order) => brio_rounds(n, order),
         None => ((0..n as u32).collect(), vec![0, n]),
     };
-    // (one thread: a round is sorted while another is inserted)
     let ready = |round: &[u32]| {
-        let mut pairs: Vec<(u64, u32)> = round.iter().map(|&i| (key(i), i)).collect();
-        if order.is_some() {
-            pairs.sort_unstable();
+        let mut pairs: Vec<(u64, u32)>;
+        if ahead {
+            pairs = round.iter().map(|&i| (key(i), i)).collect();
+            if order.is_some() {
+                pairs.sort_unstable();
+            }
+        } else {
+            pairs = round.par_iter().map(|&i| (key(i), i)).collect();
+            if order.is_some() {
+                pairs.par_sort_unstable();
+            }
         }
         prepare(pairs)
     };
-    if n < 1 << 14 {
+    if n < 1 << 14 || !ahead {
         // (small: sorting takes less than starting a thread)
         return start
             .windows(2)
@@ -391,12 +402,13 @@ mod tests {
             .all(|w| w[0][0].abs_diff(w[1][0]) + w[0][1].abs_diff(w[1][1]) == 1));
     }
 
-    /// The indices of `keys` in the order [`in_rounds`] feeds them.
-    fn fed_order(keys: &[u64], order: Brio) -> Vec<u32> {
+    /// The indices of `keys` in the order [`in_rounds`] feeds them, sorted ahead or not
+    /// (the same order).
+    fn fed_order(keys: &[u64], order: Brio, ahead: bool) -> Vec<u32> {
         let mut fed = Vec::new();
         let all: Result<(), ()> = in_rounds(
             keys.len(),
-            Some(order),
+            (Some(order), ahead),
             |i| keys[i as usize],
             |round| round,
             |round| {
@@ -422,7 +434,8 @@ mod tests {
                 "growth {growth}: {sizes:?}"
             );
             // fed: a permutation, sorted by key within each round
-            let fed = fed_order(&keys, order);
+            let fed = fed_order(&keys, order, true);
+            assert_eq!(fed, fed_order(&keys, order, false));
             let mut seen = fed.clone();
             seen.sort_unstable();
             assert_eq!(seen, (0..1000).collect::<Vec<u32>>());
@@ -460,29 +473,33 @@ mod tests {
             round.sort_by_key(|&i| keys[i as usize]);
             expected.extend(round);
         }
-        assert_eq!(fed_order(&keys, Brio::doubling(9)), expected);
+        for ahead in [true, false] {
+            assert_eq!(fed_order(&keys, Brio::doubling(9), ahead), expected);
+        }
         // a consumer that stops after three rounds: the helper stops too (no hang)
-        let mut rounds = 0;
-        let stopped = in_rounds(
-            keys.len(),
-            Some(Brio::doubling(9)),
-            |i| keys[i as usize],
-            |round| round,
-            |_| {
-                rounds += 1;
-                if rounds == 3 {
-                    Err(rounds)
-                } else {
-                    Ok(())
-                }
-            },
-        );
-        assert_eq!((stopped, rounds), (Err(3), 3));
+        for ahead in [true, false] {
+            let mut rounds = 0;
+            let stopped = in_rounds(
+                keys.len(),
+                (Some(Brio::doubling(9)), ahead),
+                |i| keys[i as usize],
+                |round| round,
+                |_| {
+                    rounds += 1;
+                    if rounds == 3 {
+                        Err(rounds)
+                    } else {
+                        Ok(())
+                    }
+                },
+            );
+            assert_eq!((stopped, rounds), (Err(3), 3));
+        }
         // without a seed: one round, in index order
         let mut fed = Vec::new();
         let plain: Result<(), ()> = in_rounds(
             keys.len(),
-            None,
+            (None, true),
             |i| keys[i as usize],
             |round| round,
             |round| {

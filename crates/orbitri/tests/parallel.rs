@@ -64,6 +64,35 @@ fn a_torus_build_is_the_same_for_every_thread_count_and_equals_the_sequential_on
 }
 
 #[test]
+fn an_unsorted_build_with_threads_is_the_same_for_every_thread_count_and_equals_one_by_one() {
+    // without the spatial sort the items come in their order: each wave is a copy sorted
+    // along the curve, its items named by their index (a sorted one is read in place)
+    let torus = FlatTorus3::cuboid([1.0, 1.5, 1.0]).unwrap();
+    let mut pts = common::uniform(9_000, 3, [1.0, 1.5, 1.0]);
+    pts.extend_from_within(4000..4010);
+    let unsorted = |threads| BuildOptions {
+        threads,
+        spatial_sort: false,
+        ..BuildOptions::default()
+    };
+    same_for_every_thread_count(|threads| {
+        let tri =
+            PeriodicDelaunay3::build_with(torus.clone(), &pts, unsorted(threads), go).unwrap();
+        (tri.cells(Copies::Stored), tri.first_occurrences())
+    });
+    let bulk = PeriodicDelaunay3::build_with(torus.clone(), &pts, unsorted(Some(2)), go).unwrap();
+    let one_by_one = PeriodicDelaunay3::build_with(torus, &pts, unsorted(None), go).unwrap();
+    assert!(bulk.is_valid().is_ok());
+    common::brute_force_check(&bulk, &pts);
+    assert_eq!(
+        common::canonical_cells(&bulk.cells(Copies::Unique)),
+        common::canonical_cells(&one_by_one.cells(Copies::Unique))
+    );
+    assert_eq!(bulk.first_occurrences(), one_by_one.first_occurrences());
+    assert_eq!(bulk.number_of_vertices(), 9_000);
+}
+
+#[test]
 fn a_cocircular_grid_and_a_batch_are_the_same_for_every_thread_count() {
     // every square of the grid is cocircular: the perturbation decides, whatever the order
     let grid: Vec<[f64; 2]> = (0..150 * 150)

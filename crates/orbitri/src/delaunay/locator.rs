@@ -11,6 +11,10 @@
 //! (Checking that the entry's point still lies in its grid cell cost a cache miss and a
 //! key per jump: 8 % of a 10⁶-point build on the sphere.)
 
+use std::sync::atomic::Ordering::Relaxed;
+
+use rayon::prelude::*;
+
 use super::Engine;
 use crate::ids::{CellId, PointId, VertexId};
 use crate::space::OrbitSpace;
@@ -102,6 +106,33 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
             let k = self.locator.slot(key);
             self.locator.slots[k] = v;
         }
+    }
+
+    /// [`Self::note_vertex`] of the vertices `first..first + count` in id order, vertex
+    /// `first + i` at spatial key `key(i)`, on rayon's pool: each grid cell ends naming the
+    /// largest of them in it, as noting them one by one does (they are newer than every
+    /// vertex the grid names).
+    pub(super) fn note_vertices(
+        &mut self,
+        first: usize,
+        count: usize,
+        key: impl Fn(usize) -> u64 + Sync,
+    ) {
+        if self.points.len() >= 2 * self.locator.sized_for {
+            return self.refill_locator();
+        }
+        let locator = &mut self.locator;
+        let shift = locator.shift;
+        let slots = VertexId::atomics(&mut locator.slots);
+        (0..count)
+            .into_par_iter()
+            .with_min_len(1 << 12)
+            .for_each(|i| {
+                let v = (first + i) as u32;
+                // (none there, or an older vertex: `NONE + 1` wraps to 0)
+                let _ = slots[(key(i) >> shift) as usize]
+                    .fetch_update(Relaxed, Relaxed, |w| (w.wrapping_add(1) <= v).then_some(v));
+            });
     }
 
     /// After point `p` took a new id (1-sheeted: its vertex has it), its grid cell names it

@@ -434,16 +434,20 @@ impl<S: SphericalSpace> SphericalTriangulation<S> {
     ) -> Result<()> {
         let mut done = 0;
         let stored = |i: u32| S::representative(points[i as usize]);
+        let ahead = self.engine.threads().is_none();
         let outcome = crate::sort::in_rounds(
             points.len(),
-            Some(Brio::doubling(seed)),
+            (Some(Brio::doubling(seed)), ahead),
             |i| sphere_key(&stored(i)),
-            // the stored representatives, gathered with their keys
+            // the stored representatives, gathered with their keys (with threads, on them)
             |round| -> Vec<Item<[f64; 3]>> {
-                round
-                    .into_iter()
-                    .map(|(key, i)| ((first + i as usize) as u32, stored(i), 0.0, key))
-                    .collect()
+                let item =
+                    |(key, i): (u64, u32)| ((first + i as usize) as u32, stored(i), 0.0, key);
+                if ahead {
+                    round.into_iter().map(item).collect()
+                } else {
+                    round.into_par_iter().map(item).collect()
+                }
             },
             |items| {
                 self.insert_items(&items, &mut |k| progress(done + k))?;
@@ -465,6 +469,15 @@ impl<S: SphericalSpace> SphericalTriangulation<S> {
         let (log, flow) = self.engine.insert_parallel(items, &mut *progress);
         if flow.is_break() {
             return Err(Error::Interrupted);
+        }
+        // (most rounds: every point new, nothing hidden)
+        let all_new = log.hidden.is_empty()
+            && (log.events.par_iter()).all(|&(_, r, _)| matches!(r, Inserted::New(_)));
+        if all_new {
+            let tables = (&mut self.point_input, &mut self.input_point[..]);
+            let input = |n: usize| InputId(items[log.events[n].0 as usize].0);
+            crate::ids::record_new_inputs(tables, log.events.len(), input);
+            return Ok(());
         }
         // (the input ids come in a random order: their slots are loaded ahead)
         let ahead = |e: usize| {
