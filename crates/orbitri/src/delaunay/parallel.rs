@@ -1,11 +1,13 @@
 //! The parallel bulk insertion, by spatial ownership.
 //!
 //! The points arrive in BRIO + Hilbert order. After a short sequential start they go in
-//! waves, each of the next as many points as there are (so that a wave at most doubles the
-//! triangulation), or where the chunks flip (below) up to eight times as many (a whole
-//! BRIO round, eightfold in 2D: consecutive points then land in the cells just made, which
-//! halved the chunks' cost a point); when fewer than a 32nd of the points are left in the
-//! call, they go one at a time. A wave is sorted along the Hilbert curve and cut into
+//! waves, each of the next up to eight times as many points as there are: a whole BRIO
+//! round, eightfold in a space without reflections (consecutive points then land in the
+//! cells just made, which halved the chunks' cost a point where they flip, and took a
+//! tenth off two threads on the sphere), doubling elsewhere (a wave of the next as many
+//! points as there are); when fewer than a 32nd of the points are left in the call, they
+//! go one at a time. A wave is in order along the Hilbert curve (a round is: it is read in
+//! place; other items are copied and sorted) and cut into
 //! [`CHUNKS`] chunks of consecutive points, and each chunk **owns** the cells of its stretch
 //! of the curve: a cell belongs to the chunk whose range holds the spatial key of its
 //! vertex 0, and a new cell to the chunk that made it. A chunk inserts its points one after
@@ -501,6 +503,13 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         (self.threads > 0).then_some(self.threads)
     }
 
+    /// True when a bulk insertion with threads should go in BRIO rounds that grow
+    /// eightfold, each one wave (see the module's comment): with threads, in a space
+    /// without reflections (where the waves double otherwise, untried).
+    pub(crate) fn eightfold_rounds(&self) -> bool {
+        self.threads > 0 && !S::MAY_REVERSE
+    }
+
     /// True when the next `left` insertions may run in parallel: a 1-sheeted, unweighted
     /// triangulation whose switch criterion holds, large enough that chunks seldom meet,
     /// and enough of them for a wave ([`FEWEST`]).
@@ -541,8 +550,8 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
                 break;
             }
             if self.wave_ready(items.len() - k) {
-                // (where the chunks flip, a whole round: see the module's comment)
-                let grow = if self.flips() { 8 } else { 1 };
+                // (a whole round, up to eightfold: see the module's comment)
+                let grow = if self.eightfold_rounds() { 8 } else { 1 };
                 let m = (items.len() - k).min(grow * self.points.len());
                 self.wave(items, k..k + m, &mut shared, &mut log);
                 k += m;

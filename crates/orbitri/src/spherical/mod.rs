@@ -435,9 +435,16 @@ impl<S: SphericalSpace> SphericalTriangulation<S> {
         let mut done = 0;
         let stored = |i: u32| S::representative(points[i as usize]);
         let ahead = self.engine.threads().is_none();
+        // (with threads, eightfold rounds, each one wave: a tenth off two threads on the
+        // sphere)
+        let order = if self.engine.eightfold_rounds() {
+            Brio::new(seed, 3)
+        } else {
+            Brio::doubling(seed)
+        };
         let outcome = crate::sort::in_rounds(
             points.len(),
-            (Some(Brio::doubling(seed)), ahead),
+            (Some(order), ahead),
             |i| sphere_key(&stored(i)),
             // the stored representatives, gathered with their keys (with threads, on them)
             |round| -> Vec<Item<[f64; 3]>> {

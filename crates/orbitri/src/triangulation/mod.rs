@@ -489,10 +489,11 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         let key = |k: u32| space.spatial_key(&points[k as usize]);
         // in 2D, rounds that grow eightfold (the last holds seven eighths of the points)
         // keep consecutive points in the cells just made: 8 % off a build of 10⁶ points in
-        // a square one at a time (none in a cube or on the sphere; BENCHMARKS.md), and a
-        // fifth off two threads where the parallel chunks flip too (orientable spaces),
-        // which take a round as one wave; elsewhere those waves double
-        let growth = if D == 2 && (self.engine.threads().is_none() || !S::MAY_REVERSE) {
+        // a square one at a time (none in a cube or on the sphere; BENCHMARKS.md); with
+        // threads, the waves take such rounds whole wherever they are used (a fifth off two
+        // threads in a square, where the chunks flip; a tenth on the sphere)
+        let one_at_a_time = D == 2 && self.engine.threads().is_none();
+        let growth = if one_at_a_time || self.engine.eightfold_rounds() {
             3
         } else {
             1
