@@ -41,16 +41,10 @@ macro_rules! id {
                 self.0 as usize
             }
 
-            /// A store of ids as atomics, for threads that write it at once (each its
-            /// own entries, or racing to a result that does not depend on the order).
-            pub fn atomics(ids: &mut [Self]) -> &[AtomicU32] {
-                // SAFETY: `#[repr(transparent)]` over `u32`, which `AtomicU32` has the
-                // size and bit validity of, and ids are 4-aligned as `u32`s are here
-                // (checked below); the mutable borrow is exclusive while the atomics live.
-                const { assert!(std::mem::align_of::<u32>() == std::mem::align_of::<AtomicU32>()) };
-                unsafe { std::slice::from_raw_parts(ids.as_mut_ptr().cast(), ids.len()) }
-            }
         }
+
+        // SAFETY: `#[repr(transparent)]` over `u32`.
+        unsafe impl TransparentU32 for $name {}
 
         /// Hashes as its number; a slice of ids as one slice of numbers (a derived `Hash`
         /// would write them one by one: the gift wrapping's facet keys are arrays of ids).
@@ -111,6 +105,22 @@ id!(
     InputId
 );
 
+/// A type laid out as a `u32` (the ids: `#[repr(transparent)]` over one).
+///
+/// # Safety
+/// Implement only for types with the size, alignment and bit validity of `u32`.
+pub(crate) unsafe trait TransparentU32: Copy {}
+
+/// A store of ids as atomics, for threads that write it at once (each its own entries,
+/// or racing to a result that does not depend on the order).
+pub(crate) fn atomics<T: TransparentU32>(ids: &mut [T]) -> &[AtomicU32] {
+    const { assert!(std::mem::align_of::<u32>() == std::mem::align_of::<AtomicU32>()) };
+    // SAFETY: `T` is laid out as a `u32` (`TransparentU32`), which `AtomicU32` has the size
+    // and bit validity of and here the alignment (checked above); the mutable borrow is
+    // exclusive while the atomics live.
+    unsafe { std::slice::from_raw_parts(ids.as_mut_ptr().cast(), ids.len()) }
+}
+
 /// Records that inputs `input(n)`, `n < count`, became the points `point_input.len() + n`
 /// (a bulk insertion whose points were all new): each names the other, in `input_point`
 /// and `point_input`. On rayon's pool: the inputs come in a random order, and one by one
@@ -122,7 +132,7 @@ pub(crate) fn record_new_inputs(
 ) {
     let first = point_input.len();
     point_input.par_extend((0..count).into_par_iter().map(&input));
-    let slots = PointId::atomics(input_point);
+    let slots = atomics(input_point);
     (0..count)
         .into_par_iter()
         .with_min_len(1 << 12)
@@ -134,6 +144,40 @@ pub(crate) fn record_new_inputs(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn ids_as_atomics_write_the_store() {
+        let mut ids = vec![PointId::NONE; 4];
+        let shared = atomics(&mut ids);
+        shared[2].store(7, Relaxed);
+        shared[0].fetch_max(3, Relaxed);
+        assert_eq!(
+            ids,
+            [PointId::NONE, PointId::NONE, PointId(7), PointId::NONE]
+        );
+    }
+
+    #[test]
+    fn new_inputs_and_their_points_name_each_other() {
+        // two points already; 20 000 inputs of which every other one becomes a point,
+        // in a shuffled order
+        let mut point_input = vec![InputId(5), InputId(9)];
+        let mut input_point = vec![PointId::NONE; 20_000];
+        let order: Vec<u32> = (0..10_000u32).map(|n| (n * 7919 % 10_000) * 2).collect();
+        let tables = (&mut point_input, &mut input_point[..]);
+        record_new_inputs(tables, order.len(), |n| InputId(order[n]));
+        assert_eq!(point_input.len(), 10_002);
+        assert_eq!(&point_input[..2], &[InputId(5), InputId(9)]);
+        for (n, &i) in order.iter().enumerate() {
+            assert_eq!(point_input[2 + n], InputId(i));
+            assert_eq!(input_point[i as usize], PointId::new(2 + n));
+        }
+        assert!(input_point
+            .iter()
+            .skip(1)
+            .step_by(2)
+            .all(|&p| p == PointId::NONE));
+    }
 
     #[test]
     fn ids_are_their_numbers() {

@@ -259,7 +259,7 @@ pub fn in_rounds<T: Send, E>(
         prepare(pairs)
     };
     if n < 1 << 14 || !ahead {
-        // (small: sorting takes less than starting a thread)
+        // (small: sorting takes less than starting a thread; with threads: on the pool)
         return start
             .windows(2)
             .try_for_each(|r| consume(ready(&idx[r[0]..r[1]])));

@@ -109,30 +109,28 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     }
 
     /// [`Self::note_vertex`] of the vertices `first..first + count` in id order, vertex
-    /// `first + i` at spatial key `key(i)`, on rayon's pool: each grid cell ends naming the
-    /// largest of them in it, as noting them one by one does (they are newer than every
-    /// vertex the grid names).
+    /// `first + i` at spatial key `key(i)`, on rayon's pool: each grid cell they fall in
+    /// ends naming the largest of them there, as noting them one by one does (its entry
+    /// cleared first, then an atomic maximum: the same whatever the threads' order).
     pub(super) fn note_vertices(
         &mut self,
         first: usize,
         count: usize,
         key: impl Fn(usize) -> u64 + Sync,
     ) {
+        if count == 0 {
+            return;
+        }
         if self.points.len() >= 2 * self.locator.sized_for {
             return self.refill_locator();
         }
         let locator = &mut self.locator;
         let shift = locator.shift;
-        let slots = VertexId::atomics(&mut locator.slots);
-        (0..count)
-            .into_par_iter()
-            .with_min_len(1 << 12)
-            .for_each(|i| {
-                let v = (first + i) as u32;
-                // (none there, or an older vertex: `NONE + 1` wraps to 0)
-                let _ = slots[(key(i) >> shift) as usize]
-                    .fetch_update(Relaxed, Relaxed, |w| (w.wrapping_add(1) <= v).then_some(v));
-            });
+        let slots = crate::ids::atomics(&mut locator.slots);
+        let cell = |i: usize| &slots[(key(i) >> shift) as usize];
+        let all = || (0..count).into_par_iter().with_min_len(1 << 12);
+        all().for_each(|i| cell(i).store(0, Relaxed));
+        all().for_each(|i| _ = cell(i).fetch_max((first + i) as u32, Relaxed));
     }
 
     /// After point `p` took a new id (1-sheeted: its vertex has it), its grid cell names it
@@ -190,6 +188,34 @@ mod tests {
             assert_eq!(e.locator.slot(e.space.spatial_key(p)), k, "grid cell {k}");
         }
         named.len()
+    }
+
+    #[test]
+    fn vertices_noted_at_once_leave_the_grid_as_noted_one_by_one() {
+        let mut e = uniform_cube(3000, 5);
+        let keys: Vec<u64> = e.points.iter().map(|p| e.space.spatial_key(p)).collect();
+        // stale entries too: a vertex named far from its point, and one past the points
+        let n = e.locator.slots.len();
+        e.locator.slots[n / 2] = VertexId::new(2999);
+        e.locator.slots[n / 3] = VertexId::new(5000);
+        let mut one_by_one = e.clone();
+        // points 1000.. noted again, with keys that fall on grid cells named before
+        let key = |i: usize| keys[1000 + (i * 7) % 2000];
+        for i in 0..2000 {
+            one_by_one.note_vertex(VertexId::new(1000 + i), key(i));
+        }
+        e.note_vertices(1000, 2000, key);
+        assert_eq!(e.locator.slots, one_by_one.locator.slots);
+        // nothing noted: nothing changes (no refill either)
+        let before = e.locator.slots.clone();
+        e.locator.sized_for = 1;
+        e.note_vertices(3000, 0, key);
+        assert_eq!(e.locator.slots, before);
+        // the points doubled since the grid was sized: refilled, as one by one does
+        one_by_one.locator.sized_for = 1;
+        one_by_one.note_vertex(VertexId::new(1000), key(0));
+        e.note_vertices(1000, 1, key);
+        assert_eq!(e.locator.slots, one_by_one.locator.slots);
     }
 
     #[test]

@@ -424,7 +424,8 @@ impl<S: SphericalSpace> SphericalTriangulation<S> {
 
     /// Inserts `points` (input ids from `first`, their slots in `input_point` made) in
     /// BRIO + Hilbert order, a round at a time, each sorted while the one before it is
-    /// inserted ([`crate::sort::in_rounds`]); `Err` if `progress` stopped it.
+    /// inserted one at a time, or with threads on them before it
+    /// ([`crate::sort::in_rounds`]); `Err` if `progress` stopped it.
     fn insert_rounds(
         &mut self,
         points: &[[f64; 3]],
@@ -481,6 +482,9 @@ impl<S: SphericalSpace> SphericalTriangulation<S> {
         let all_new = log.hidden.is_empty()
             && (log.events.par_iter()).all(|&(_, r, _)| matches!(r, Inserted::New(_)));
         if all_new {
+            let first = self.point_input.len();
+            debug_assert!((log.events.iter().enumerate())
+                .all(|(n, e)| e.1 == Inserted::New(PointId::new(first + n))));
             let tables = (&mut self.point_input, &mut self.input_point[..]);
             let input = |n: usize| InputId(items[log.events[n].0 as usize].0);
             crate::ids::record_new_inputs(tables, log.events.len(), input);

@@ -473,7 +473,8 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
     /// Inserts internal `points` (with `weights`, none when unweighted), point `k` as
     /// input `first + k`, in BRIO + Hilbert order by `seed` (without one, in their order), a
     /// round at a time, each sorted on a helper thread while the ones before it are
-    /// inserted ([`crate::sort::in_rounds`]); records each in the engine's order while
+    /// inserted one at a time, or with threads on them before it
+    /// ([`crate::sort::in_rounds`]); records each in the engine's order while
     /// `keep(result, points it hid)` holds: false when one does not (the rest unrecorded),
     /// `Err` if `progress` stopped it. The first `dummies` points of the engine are a
     /// build's dummy points, which leave between rounds when they can ([`Leaving`]).
@@ -490,8 +491,8 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         // in 2D, rounds that grow eightfold (the last holds seven eighths of the points)
         // keep consecutive points in the cells just made: 8 % off a build of 10⁶ points in
         // a square one at a time (none in a cube or on the sphere; BENCHMARKS.md); with
-        // threads, the waves take such rounds whole wherever they are used (a fifth off two
-        // threads in a square, where the chunks flip; a tenth on the sphere)
+        // threads, in any dimension in a space without reflections, each such round is
+        // one wave ([`Engine::eightfold_rounds`]: a fifth off two threads in a square)
         let one_at_a_time = D == 2 && self.engine.threads().is_none();
         let growth = if one_at_a_time || self.engine.eightfold_rounds() {
             3
@@ -594,6 +595,9 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
                 .par_iter()
                 .all(|&(_, r, _)| matches!(r, Inserted::New(_)) && keep(r, &[]));
         if all_new {
+            let first = self.point_input.len();
+            debug_assert!((log.events.iter().enumerate())
+                .all(|(n, e)| e.1 == Inserted::New(PointId::new(first + n))));
             let tables = (&mut self.point_input, &mut self.input_point[..]);
             let input = |n: usize| InputId(items[log.events[n].0 as usize].0);
             crate::ids::record_new_inputs(tables, log.events.len(), input);
