@@ -55,7 +55,7 @@ use super::flip::{split_and_flip, Flipper, Triangle};
 use super::insert::{closes, edge_ends, enter, next_edge, slot_in, Frame, Refused};
 use super::ridges::Ridges;
 use super::{Engine, HiddenPoint, Inserted};
-use crate::ids::{CellId, PointId, VertexId};
+use crate::ids::{CellId, InputId, PointId, VertexId};
 use crate::sort::SplitMix;
 use crate::space::OrbitSpace;
 use crate::tds::{replaced, Cell, Packing, Stored};
@@ -117,6 +117,31 @@ impl<P> Log<P> {
             from = end as usize;
             (tag, r, hid)
         })
+    }
+
+    /// When every event is a new point, nothing hidden, and `keep` accepts each (most
+    /// rounds): records them in a facade's tables, `point_input` and `input_point`, each
+    /// item tagged with its input id, and returns true; else records nothing, false.
+    pub(crate) fn record_if_all_new(
+        &self,
+        items: &[Item<P>],
+        tables: (&mut Vec<InputId>, &mut [PointId]),
+        keep: impl Fn(Inserted) -> bool + Sync,
+    ) -> bool
+    where
+        P: Sync,
+    {
+        let all_new = self.hidden.is_empty()
+            && (self.events.par_iter()).all(|&(_, r, _)| matches!(r, Inserted::New(_)) && keep(r));
+        if !all_new {
+            return false;
+        }
+        let first = tables.0.len();
+        debug_assert!((self.events.iter().enumerate())
+            .all(|(n, e)| e.1 == Inserted::New(PointId::new(first + n))));
+        let input = |n: usize| InputId(items[self.events[n].0 as usize].0);
+        crate::ids::record_new_inputs(tables, self.events.len(), input);
+        true
     }
 }
 
@@ -628,7 +653,7 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         // the ids of points that are not vertices, filled by the last points (most waves
         // have none: then a point's id is `base` + its position)
         let hole = |s: usize| outcome[s] != Outcome::New;
-        let holes = outcome.par_iter().any(|&o| o != Outcome::New);
+        let holes = (0..m).into_par_iter().any(hole);
         let mut id = Vec::new();
         let mut slot = Vec::new();
         if holes {

@@ -588,19 +588,8 @@ impl<const D: usize, const N: usize, S: FlatSpace<D, N>> Triangulation<D, N, S> 
         if flow.is_break() {
             return Err(Error::Interrupted);
         }
-        // (most rounds: every point new, nothing hidden)
-        let all_new = log.hidden.is_empty()
-            && log
-                .events
-                .par_iter()
-                .all(|&(_, r, _)| matches!(r, Inserted::New(_)) && keep(r, &[]));
-        if all_new {
-            let first = self.point_input.len();
-            debug_assert!((log.events.iter().enumerate())
-                .all(|(n, e)| e.1 == Inserted::New(PointId::new(first + n))));
-            let tables = (&mut self.point_input, &mut self.input_point[..]);
-            let input = |n: usize| InputId(items[log.events[n].0 as usize].0);
-            crate::ids::record_new_inputs(tables, log.events.len(), input);
+        let tables = (&mut self.point_input, &mut self.input_point[..]);
+        if log.record_if_all_new(&items, tables, |r| keep(r, &[])) {
             return Ok(true);
         }
         for (n, (k, r, hid)) in log.iter().enumerate() {
