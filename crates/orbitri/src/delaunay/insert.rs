@@ -6,7 +6,7 @@ use crate::ids::{CellId, PointId, VertexId};
 use crate::predicates::Sign;
 use crate::sort::SplitMix;
 use crate::space::OrbitSpace;
-use crate::tds::{replaced, Cell};
+use crate::tds::replaced;
 
 /// Why a lifted point was not inserted.
 pub(crate) enum Refused {
@@ -303,9 +303,8 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     fn star_around(&mut self, scratch: &mut Scratch<S::Elem>, x: VertexId) {
         let rim = std::mem::take(&mut self.around.rim);
         for (&facet, &(_, _, j)) in scratch.boundary.iter().zip(&rim) {
-            let (nc, cell) = self.cell_on_facet(scratch, facet, x);
-            let i = facet.1 as usize;
-            self.link(nc, self.slot(nc, x, i), cell.n[i], j as usize);
+            let (nc, outside) = self.cell_on_facet(scratch, facet, x);
+            self.link(nc, self.slot(nc, x, facet.1 as usize), outside, j as usize);
             scratch.created.push(nc);
         }
         let m = rim.len();
@@ -344,21 +343,26 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
 
     /// The new cell on boundary facet `(ci, i)` of the conflict region: conflict cell `ci`
     /// with `x` (lifted as the point is there) in place of its vertex `i`; returned with
-    /// the conflict cell as it is.
+    /// the conflict cell's neighbour across that facet. When `x`'s element there is the
+    /// one it replaces (inside the domain, every element is the identity), the new cell has
+    /// the conflict cell's elements, which are canonical, and takes them as stored.
     #[inline(always)]
     fn cell_on_facet(
         &mut self,
         scratch: &Scratch<S::Elem>,
         (ci, i): (u32, u8),
         x: VertexId,
-    ) -> (CellId, Cell<S::Elem, N>) {
+    ) -> (CellId, CellId) {
         let (c, qo) = scratch.conflict[ci as usize];
-        let cell = self.tds.cell(c);
         let i = i as usize;
-        (
-            self.make_cell(replaced(cell.v, i, x), replaced(cell.off, i, qo)),
-            cell,
-        )
+        let stored = &self.tds.cells[c.index()];
+        let (v, outside) = (replaced(stored.v, i, x), stored.n[i]);
+        let nc = if self.tds.off_at(c, i) == qo {
+            self.make_cell_like(v, c)
+        } else {
+            self.make_cell(v, replaced(self.tds.off(c), i, qo))
+        };
+        (nc, outside)
     }
 
     /// The slot of vertex `y` in the new 2D cell `c` built on edge `i` of a conflict cell.
@@ -373,9 +377,8 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
         // 1. one new cell per boundary facet, linked to the outside neighbour; the conflict
         //    cell's pointer through that facet is redirected to the new cell.
         for &facet in &scratch.boundary {
-            let (nc, cell) = self.cell_on_facet(scratch, facet, x);
+            let (nc, d) = self.cell_on_facet(scratch, facet, x);
             let (c, i) = (scratch.conflict[facet.0 as usize].0, facet.1 as usize);
-            let d = cell.n[i];
             let j = self.mirror_of(d, c);
             self.link(nc, self.slot(nc, x, i), d, j);
             self.tds.cells[c.index()].n[i] = nc;

@@ -694,6 +694,20 @@ impl<S: OrbitSpace<N>, const N: usize> Engine<S, N> {
     #[inline(always)]
     fn add_cell(&mut self, cell: Cell<S::Elem, N>) -> CellId {
         let id = self.tds.create(cell);
+        self.added(id)
+    }
+
+    /// Creates a cell of vertices `v` with the elements of the live cell `like` (canonical
+    /// already) and keeps the criterion bookkeeping.
+    #[inline(always)]
+    fn make_cell_like(&mut self, v: [VertexId; N], like: CellId) -> CellId {
+        let id = self.tds.create_like(v, like);
+        self.added(id)
+    }
+
+    /// Keeps the criterion bookkeeping of the new cell `id`.
+    #[inline(always)]
+    fn added(&mut self, id: CellId) -> CellId {
         if !self.guaranteed {
             self.track(id);
         }

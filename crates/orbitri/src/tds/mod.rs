@@ -229,10 +229,11 @@ pub(crate) fn first_equal<T: PartialEq + Copy, const N: usize>(a: &[T; N], x: T)
 }
 
 /// `a` with `x` in slot `i`, chosen slot by slot (where a store into a computed slot
-/// followed by a copy of the whole cell waits for the store).
+/// followed by a copy of the whole cell waits for the store), without a branch: the slot
+/// is as good as random.
 #[inline(always)]
 pub fn replaced<T: Copy, const N: usize>(a: [T; N], i: usize, x: T) -> [T; N] {
-    std::array::from_fn(|k| if k == i { x } else { a[k] })
+    std::array::from_fn(|k| std::hint::select_unpredictable(k == i, x, a[k]))
 }
 
 /// Asks the processor to start loading `x` into its caches, every line it spans (a
@@ -402,6 +403,41 @@ impl<O: Packing, const N: usize> Tds<O, N> {
                 wide.resize(id.index() + 1, c.off);
                 wide[id.index()] = c.off;
             }
+        }
+        id
+    }
+
+    /// Adds a cell of vertices `v`, no neighbours yet, and the elements of the live cell
+    /// `like` copied as they are stored (no unpacking, no packing: most new cells of a star
+    /// have the elements of the conflict cell they replace), reusing a free slot when there
+    /// is one.
+    #[inline(always)]
+    pub fn create_like(&mut self, v: [VertexId; N], like: CellId) -> CellId {
+        let slots = self.cells[like.index()].slots;
+        let n = [CellId::NONE; N];
+        let id = match self.free.pop() {
+            Some(id) => {
+                let slot = &mut self.cells[id.index()];
+                (slot.v, slot.n, slot.slots) = (v, n, slots);
+                id
+            }
+            None => {
+                let id = CellId::new(self.cells.len());
+                self.cells.push(Stored {
+                    v,
+                    n,
+                    slots,
+                    stamp: 0,
+                });
+                id
+            }
+        };
+        if let Some(wide) = &mut self.wide {
+            let off = wide[like.index()];
+            if wide.len() <= id.index() {
+                wide.resize(id.index() + 1, off);
+            }
+            wide[id.index()] = off;
         }
         id
     }
@@ -642,6 +678,37 @@ mod tests {
         tds.clear();
         tds.create(Cell::new(vs([0, 1, 2, 3]), small));
         assert!(tds.is_packed());
+    }
+
+    /// A cell made like another takes that one's elements, packed or wide, with no
+    /// neighbours, in a free slot when there is one.
+    #[test]
+    fn a_cell_made_like_another_takes_its_elements() {
+        let mut tds: Tds<[i8; 3], 4> = Tds::new();
+        let vs = |v: [u32; 4]| v.map(VertexId);
+        let small = [[0, 0, 0], [1, 0, 0], [0, 1, 1], [3, 3, 3]];
+        let mut linked = Cell::new(vs([0, 1, 2, 3]), small);
+        linked.n = [CellId::new(5); 4];
+        let a = tds.create(linked);
+        let b = tds.create_like(vs([4, 1, 2, 3]), a);
+        assert!(tds.is_packed());
+        assert_eq!(tds.cell(b), Cell::new(vs([4, 1, 2, 3]), small));
+        // a freed slot is reused, its stamp kept
+        tds.set_stamp(b, 7);
+        tds.delete(b);
+        assert_eq!(tds.create_like(vs([5, 1, 2, 3]), a), b);
+        assert_eq!((tds.off(b), tds.stamp(b)), (small, 7));
+        // wide: the elements beside the cells, for a new slot and a reused one
+        let large = [[0, 0, 0], [4, 0, 0], [0, 1, 7], [2, 0, 1]];
+        let c = tds.create(Cell::new(vs([2, 3, 4, 5]), large));
+        assert!(!tds.is_packed());
+        let d = tds.create_like(vs([9, 3, 4, 5]), c);
+        assert_eq!(tds.cell(d), Cell::new(vs([9, 3, 4, 5]), large));
+        tds.delete(b);
+        assert_eq!(tds.create_like(vs([6, 3, 4, 5]), c), b);
+        assert_eq!((tds.off(b), tds.off(a)), (large, small));
+        assert_eq!(tds.create_like(vs([6, 1, 2, 3]), a), CellId::new(4));
+        assert_eq!(tds.off(CellId::new(4)), small);
     }
 
     #[test]
