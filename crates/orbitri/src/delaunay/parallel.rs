@@ -1277,18 +1277,26 @@ unsafe fn commit<S: OrbitSpace<N>, const N: usize>(
     new.clear();
     for (k, &(ci, i)) in ch.boundary.iter().enumerate() {
         let (ci, i) = (ci as usize, i as usize);
-        let was = &old[ci];
-        let mut cell = Cell::new(
-            replaced(was.v, i, x),
-            replaced(was.packed_offsets(), i, ch.conflict[ci].1),
-        );
-        if space.normalize(&mut cell.off, level) && S::MAY_REVERSE {
-            cell.swap_slots(0, 1);
-        }
-        let slot = cell.index_of(x).expect("the new vertex");
-        cell.n = replaced(cell.n, slot, ch.across[k].0);
-        let Some(cell) = Stored::pack(&cell) else {
-            return Commit::Unpacked;
+        let (was, qo) = (&old[ci], ch.conflict[ci].1);
+        // (inside the domain, the conflict cell's elements as they are packed)
+        let cell = match was.with_same_elements(i, x, qo) {
+            Some(mut cell) => {
+                cell.n[i] = ch.across[k].0;
+                cell
+            }
+            None => {
+                let mut cell =
+                    Cell::new(replaced(was.v, i, x), replaced(was.packed_offsets(), i, qo));
+                if space.normalize(&mut cell.off, level) && S::MAY_REVERSE {
+                    cell.swap_slots(0, 1);
+                }
+                let slot = cell.index_of(x).expect("the new vertex");
+                cell.n = replaced(cell.n, slot, ch.across[k].0);
+                let Some(cell) = Stored::pack(&cell) else {
+                    return Commit::Unpacked;
+                };
+                cell
+            }
         };
         new.push(cell);
     }

@@ -191,6 +191,21 @@ impl<O: Packing, const N: usize> Stored<O, N> {
         self.slots.map(O::unpack)
     }
 
+    /// This cell with vertex `x` in slot `i`, no neighbours and stamp 0, when `x`'s element
+    /// `o` is the one there: the same elements, kept as they are packed (canonical already).
+    #[inline(always)]
+    pub fn with_same_elements(&self, i: usize, x: VertexId, o: O) -> Option<Self>
+    where
+        O: PartialEq,
+    {
+        (O::unpack(self.slots[i]) == o).then(|| Stored {
+            v: replaced(self.v, i, x),
+            n: [CellId::NONE; N],
+            slots: self.slots,
+            stamp: 0,
+        })
+    }
+
     /// Index of vertex `x` in this cell.
     #[inline]
     pub fn index_of(&self, x: VertexId) -> Option<usize> {
@@ -709,6 +724,23 @@ mod tests {
         assert_eq!((tds.off(b), tds.off(a)), (large, small));
         assert_eq!(tds.create_like(vs([6, 1, 2, 3]), a), CellId::new(4));
         assert_eq!(tds.off(CellId::new(4)), small);
+    }
+
+    #[test]
+    fn a_stored_cell_with_a_vertex_replaced_keeps_its_elements_only_when_they_are_the_same() {
+        let small = [[0, 0, 0], [1, 0, 0], [0, 1, 1], [3, 3, 3]];
+        let mut cell = Cell::new([0, 1, 2, 3].map(VertexId), small);
+        cell.n = [CellId::new(5); 4];
+        let mut stored = Stored::pack(&cell).unwrap();
+        stored.set_stamp(9);
+        let made = stored
+            .with_same_elements(2, VertexId(7), [0, 1, 1])
+            .unwrap();
+        let want = Cell::new([0, 1, 7, 3].map(VertexId), small);
+        assert_eq!(made, Stored::pack(&want).unwrap());
+        assert_eq!(made.stamp(), 0);
+        assert_eq!(stored.with_same_elements(2, VertexId(7), [0, 0, 0]), None);
+        assert_eq!(stored.with_same_elements(1, VertexId(7), [0, 0, 0]), None);
     }
 
     #[test]
