@@ -398,28 +398,43 @@ impl<O: Packing, const N: usize> Tds<O, N> {
     /// Adds a cell, reusing a free slot when there is one.
     #[inline(always)]
     pub fn create(&mut self, c: Cell<O, N>) -> CellId {
+        if let Some(packed) = Stored::pack(&c).filter(|_| self.is_packed()) {
+            return self.add_packed(packed);
+        }
         if let Some(id) = self.free.pop() {
             // keep the old stamp: it belongs to an earlier visit
             self.put(id, c);
             return id;
         }
         let id = CellId::new(self.cells.len());
-        match Stored::pack(&c) {
-            Some(p) if self.is_packed() => self.cells.push(p),
-            _ => {
-                self.cells.push(Stored {
-                    v: c.v,
-                    n: c.n,
-                    slots: [O::Slot::default(); N],
-                    stamp: 0,
-                });
-                // (widened now: the new slot is among those read; wide already: one more)
-                let wide = self.widen();
-                wide.resize(id.index() + 1, c.off);
-                wide[id.index()] = c.off;
+        self.cells.push(Stored {
+            v: c.v,
+            n: c.n,
+            slots: [O::Slot::default(); N],
+            stamp: 0,
+        });
+        // (widened now: the new slot is among those read; wide already: one more)
+        let wide = self.widen();
+        wide.resize(id.index() + 1, c.off);
+        wide[id.index()] = c.off;
+        id
+    }
+
+    /// Adds a packed cell to a packed store, in a free slot (its old stamp kept: it belongs
+    /// to an earlier visit) when there is one.
+    #[inline(always)]
+    fn add_packed(&mut self, cell: Stored<O, N>) -> CellId {
+        match self.free.pop() {
+            Some(id) => {
+                let slot = &mut self.cells[id.index()];
+                (slot.v, slot.n, slot.slots) = (cell.v, cell.n, cell.slots);
+                id
+            }
+            None => {
+                self.cells.push(cell);
+                CellId::new(self.cells.len() - 1)
             }
         }
-        id
     }
 
     /// Adds a cell of vertices `v`, no neighbours yet, and the elements of the live cell
@@ -428,33 +443,15 @@ impl<O: Packing, const N: usize> Tds<O, N> {
     /// is one.
     #[inline(always)]
     pub fn create_like(&mut self, v: [VertexId; N], like: CellId) -> CellId {
-        let slots = self.cells[like.index()].slots;
-        let n = [CellId::NONE; N];
-        let id = match self.free.pop() {
-            Some(id) => {
-                let slot = &mut self.cells[id.index()];
-                (slot.v, slot.n, slot.slots) = (v, n, slots);
-                id
-            }
-            None => {
-                let id = CellId::new(self.cells.len());
-                self.cells.push(Stored {
-                    v,
-                    n,
-                    slots,
-                    stamp: 0,
-                });
-                id
-            }
-        };
-        if let Some(wide) = &mut self.wide {
-            let off = wide[like.index()];
-            if wide.len() <= id.index() {
-                wide.resize(id.index() + 1, off);
-            }
-            wide[id.index()] = off;
+        if !self.is_packed() {
+            return self.create(Cell::new(v, self.off(like)));
         }
-        id
+        self.add_packed(Stored {
+            v,
+            n: [CellId::NONE; N],
+            slots: self.cells[like.index()].slots,
+            stamp: 0,
+        })
     }
 
     /// Removes a cell (its slot goes to the free list).
